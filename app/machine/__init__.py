@@ -1,0 +1,1 @@
+"""The machine interface (a Protocol) and its simulated implementation."""

@@ -1,0 +1,1 @@
+"""Measuring engine: pure numpy, no I/O, no globals (design.md §2)."""

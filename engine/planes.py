@@ -1,0 +1,79 @@
+"""Working planes G17/G18/G19 (measuring-math §0.1, spec/jog-measuring.md §9.2).
+
+(a, o, p) = abscissa, ordinate, applicate (infeed axis); right-handed in every plane.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+_AXIS_INDEX = {"X": 0, "Y": 1, "Z": 2}
+
+
+@dataclass(frozen=True)
+class Plane:
+    name: str          # "G17" | "G18" | "G19"
+    axes: tuple[str, str, str]  # (abscissa, ordinate, applicate)
+
+    @property
+    def first(self) -> str:
+        return self.axes[0]
+
+    @property
+    def second(self) -> str:
+        return self.axes[1]
+
+    @property
+    def infeed(self) -> str:
+        return self.axes[2]
+
+    @property
+    def index(self) -> tuple[int, int, int]:
+        return tuple(_AXIS_INDEX[a] for a in self.axes)  # type: ignore[return-value]
+
+    @property
+    def aop2xyz(self) -> np.ndarray:
+        """3x3 matrix whose columns are the unit vectors of a, o, p in XYZ: p_xyz = M @ p_aop."""
+        m = np.zeros((3, 3))
+        for col, idx in enumerate(self.index):
+            m[idx, col] = 1.0
+        return m
+
+    def to_aop(self, p_xyz) -> np.ndarray:
+        return np.asarray(p_xyz, dtype=float) @ self.aop2xyz
+
+    def to_xyz(self, p_aop) -> np.ndarray:
+        return np.asarray(p_aop, dtype=float) @ self.aop2xyz.T
+
+    def unit(self, axis: str) -> np.ndarray:
+        e = np.zeros(3)
+        e[_AXIS_INDEX[axis]] = 1.0
+        return e
+
+    @property
+    def infeed_unit(self) -> np.ndarray:
+        """Unit vector of the applicate (tool axis, pointing from tip to spindle)."""
+        return self.unit(self.infeed)
+
+
+PLANES = {
+    "G17": Plane("G17", ("X", "Y", "Z")),
+    "G18": Plane("G18", ("Z", "X", "Y")),
+    "G19": Plane("G19", ("Y", "Z", "X")),
+}
+
+
+def plane(name: str) -> Plane:
+    try:
+        return PLANES[name]
+    except KeyError:
+        raise ValueError(f"plane must be one of G17, G18, G19, got {name!r}") from None
+
+
+def axis_index(axis: str) -> int:
+    try:
+        return _AXIS_INDEX[axis]
+    except KeyError:
+        raise ValueError(f"axis must be X, Y or Z, got {axis!r}") from None
