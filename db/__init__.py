@@ -1,0 +1,16 @@
+"""Persistence: SQLite (WAL) through SQLAlchemy 2, Alembic migrations, a unit-of-work API.
+
+Usage::
+
+    db = Database("data/hmi.db")
+    with db.unit() as unit:          # one transaction
+        before, after = unit.put_offset("G54", frame, source="edge.set")
+        unit.add_log({"task": "edge.set", ...})
+
+Imports nothing of ``app`` or ``engine`` (design.md §2).
+"""
+
+from db.database import Database
+from db.repository import OffsetSlot, Unit, identity_frame, offset_layout
+
+__all__ = ["Database", "OffsetSlot", "Unit", "identity_frame", "offset_layout"]
