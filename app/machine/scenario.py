@@ -1,0 +1,301 @@
+"""The simulator's truth: the scenario JSON of design.md §4 as pydantic v2 models.
+
+Only the simulator sees these values; the HMI learns them by measuring. Units: mm, deg,
+mm/min, s. Every field has a default except the ones that define a feature's size.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+
+DEMO_SCENARIO_PATH = Path(__file__).with_name("demo_scenario.json")
+
+GEOMETRY_AXES = ("X", "Y", "Z")
+ROTARY_AXIS_NAMES = ("A", "B", "C")
+PRETRAVEL_KEYS = ("X+", "X-", "Y+", "Y-", "Z+", "Z-")
+
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+Vec2 = tuple[Finite, Finite]
+Vec3 = tuple[Finite, Finite, Finite]
+
+
+class _Model(BaseModel):
+    # unknown keys are typos in a truth file: refuse them so the message names the field
+    model_config = ConfigDict(extra="forbid")
+
+
+def _check_range(value: tuple[float, float], name: str) -> tuple[float, float]:
+    if value[0] >= value[1]:
+        raise ValueError(f"{name}: lower limit {value[0]} must be below upper limit {value[1]}")
+    return value
+
+
+class MachineConfig(_Model):
+    """Axis limits (MCS of the tool reference point), feeds and the braking model (§1.3)."""
+
+    limits: dict[str, Vec2] = Field(
+        default_factory=lambda: {"X": (-2000.0, 2000.0), "Y": (-2000.0, 2000.0), "Z": (-1000.0, 1000.0)})
+    rapid: Positive = 10000.0          # mm/min
+    jog_feed: Positive = 1000.0        # mm/min, jog when no feed is given
+    latency_s: NonNegative = 0.004     # signal delay t of measuring-math §1.3, s
+    decel: Positive = 1.0              # braking deceleration a, m/s^2
+    kv: Positive = 1.0                 # position loop gain Kv, (m/min)/mm
+    time_scale: NonNegative = 1.0      # 1 = real time, 0 = no waiting
+
+    @field_validator("limits")
+    @classmethod
+    def _limits_ok(cls, value: dict[str, tuple[float, float]]) -> dict[str, tuple[float, float]]:
+        for axis, rng in value.items():
+            if axis not in GEOMETRY_AXES:
+                raise ValueError(f"unknown geometry axis {axis!r} (rotary limits go in rotary_axes)")
+            _check_range(rng, f"limits.{axis}")
+        full = {"X": (-2000.0, 2000.0), "Y": (-2000.0, 2000.0), "Z": (-1000.0, 1000.0)}
+        full.update(value)
+        return full
+
+
+class ProbeNominal(_Model):
+    length: Positive | None = None
+    ball_diameter: Positive | None = None
+
+
+class ProbeConfig(_Model):
+    """The 3D workpiece probe (measuring-math §1.7): true values and what the HMI is told."""
+
+    t: int = 9
+    ball_diameter: Positive = 4.0
+    length: Positive = 100.0                       # true L1: spindle nose to ball centre
+    eccentricity: Vec2 = (0.0, 0.0)                # ball centre minus spindle axis at SPOS 0
+    nominal: ProbeNominal = Field(default_factory=ProbeNominal)
+    pretravel: dict[str, NonNegative] = Field(default_factory=dict)   # keys of PRETRAVEL_KEYS
+    noise_sigma: NonNegative = 0.0
+    max_deflection: Positive = 2.0
+
+    @field_validator("pretravel")
+    @classmethod
+    def _pretravel_keys(cls, value: dict[str, float]) -> dict[str, float]:
+        bad = sorted(set(value) - set(PRETRAVEL_KEYS))
+        if bad:
+            raise ValueError(f"unknown pre-travel direction(s) {bad}; use {list(PRETRAVEL_KEYS)}")
+        return value
+
+    @property
+    def nominal_length(self) -> float:
+        return self.nominal.length if self.nominal.length is not None else self.length
+
+    @property
+    def nominal_ball_diameter(self) -> float:
+        nominal = self.nominal.ball_diameter
+        return nominal if nominal is not None else self.ball_diameter
+
+
+class Pose(_Model):
+    """Part -> MCS: p_mcs = R(rot) p_part + trans, R = Rz(c) Ry(b) Rx(a) (design.md §3)."""
+
+    trans: Vec3 = (0.0, 0.0, 0.0)
+    rot: Vec3 = (0.0, 0.0, 0.0)
+
+
+class Block(_Model):
+    type: Literal["block"]
+    size: tuple[Positive, Positive, Positive]     # fills [0,Lx] x [0,Ly] x [-Lz,0] in part coords
+
+
+class Hole(_Model):
+    type: Literal["hole"]
+    center: Vec2
+    diameter: Positive
+    depth: Positive
+
+
+class Pocket(_Model):
+    type: Literal["pocket"]
+    center: Vec2
+    size: tuple[Positive, Positive]
+    depth: Positive
+
+
+class Spigot(_Model):
+    type: Literal["spigot"]
+    center: Vec2
+    diameter: Positive
+    height: Positive
+
+
+class Boss(_Model):
+    type: Literal["boss"]
+    center: Vec2
+    size: tuple[Positive, Positive]
+    height: Positive
+
+
+Feature = Annotated[Block | Hole | Pocket | Spigot | Boss, Field(discriminator="type")]
+
+
+class Workpiece(_Model):
+    pose: Pose = Field(default_factory=Pose)
+    features: list[Feature] = Field(default_factory=list)
+
+    @model_validator(mode="after")
+    def _one_block(self) -> Workpiece:
+        blocks = [f for f in self.features if f.type == "block"]
+        if len(blocks) > 1:
+            raise ValueError("features: at most one block per workpiece")
+        if not blocks and any(f.type in ("hole", "pocket", "spigot", "boss") for f in self.features):
+            raise ValueError("features: holes, pockets, spigots and bosses need a block to sit in/on")
+        return self
+
+    @property
+    def block(self) -> Block | None:
+        return next((f for f in self.features if f.type == "block"), None)
+
+
+class RingGauge(_Model):
+    """Calibration ring: ``center`` = centre of its top face (MCS)."""
+
+    center: Vec3
+    diameter: Positive                       # bore
+    height: Positive = 20.0
+    outer_diameter: Positive | None = None   # default bore + 30
+
+    @model_validator(mode="after")
+    def _outer(self) -> RingGauge:
+        if self.outer_diameter is None:
+            self.outer_diameter = self.diameter + 30.0
+        if self.outer_diameter <= self.diameter:
+            raise ValueError("ring_gauge.outer_diameter must be larger than the bore diameter")
+        return self
+
+
+class ToolProbe(_Model):
+    """Tool probe: a switching cylinder standing on the table, ``center`` = top-face centre."""
+
+    center: Vec3
+    disc_diameter: Positive
+    height: Positive = 40.0
+    pretravel: NonNegative = 0.0
+
+
+class ToolNominal(_Model):
+    length: Positive | None = None
+    radius: Positive | None = None
+
+
+class Tool(_Model):
+    """A true cutter: flat-end cylinder of ``radius``, tip ``length`` below the spindle nose."""
+
+    t: int
+    type: int = 120
+    length: Positive
+    radius: Positive
+    nominal: ToolNominal = Field(default_factory=ToolNominal)
+
+    @property
+    def nominal_length(self) -> float:
+        return self.nominal.length if self.nominal.length is not None else self.length
+
+    @property
+    def nominal_radius(self) -> float:
+        return self.nominal.radius if self.nominal.radius is not None else self.radius
+
+
+class RotaryAxis(_Model):
+    limits: Vec2 = (-360.0, 360.0)
+
+    @field_validator("limits")
+    @classmethod
+    def _range(cls, value: tuple[float, float]) -> tuple[float, float]:
+        return _check_range(value, "limits")
+
+
+class Scenario(_Model):
+    seed: int = 0
+    machine: MachineConfig = Field(default_factory=MachineConfig)
+    probe: ProbeConfig = Field(default_factory=ProbeConfig)
+    workpiece: Workpiece | None = None
+    ring_gauge: RingGauge | None = None
+    tool_probe: ToolProbe | None = None
+    tools: list[Tool] = Field(default_factory=list)
+    rotary_axes: dict[str, RotaryAxis] = Field(default_factory=dict)
+    start: dict[str, Finite] | None = None   # axes MCS at load; default: X/Y at 0 (clamped), Z at top
+
+    @model_validator(mode="after")
+    def _consistent(self) -> Scenario:
+        for name in self.rotary_axes:
+            if name not in ROTARY_AXIS_NAMES:
+                raise ValueError(f"rotary_axes: unknown axis {name!r}; use one of {list(ROTARY_AXIS_NAMES)}")
+        numbers = [tool.t for tool in self.tools]
+        if len(set(numbers)) != len(numbers):
+            raise ValueError("tools: tool numbers must be unique")
+        if self.probe.t in numbers:
+            raise ValueError(f"tools: T{self.probe.t} is the probe's number (probe.t)")
+        if self.start is not None:
+            for axis, value in self.start.items():
+                if axis in GEOMETRY_AXES:
+                    lo, hi = self.machine.limits[axis]
+                elif axis in self.rotary_axes:
+                    lo, hi = self.rotary_axes[axis].limits
+                else:
+                    raise ValueError(f"start: unknown axis {axis!r}")
+                if not lo <= value <= hi:
+                    raise ValueError(f"start.{axis} = {value} is outside the limits [{lo}, {hi}]")
+        return self
+
+    @property
+    def axes(self) -> tuple[str, ...]:
+        return GEOMETRY_AXES + tuple(a for a in ROTARY_AXIS_NAMES if a in self.rotary_axes)
+
+    def limits(self) -> dict[str, tuple[float, float]]:
+        out = {a: tuple(self.machine.limits[a]) for a in GEOMETRY_AXES}
+        out.update({a: tuple(ax.limits) for a, ax in self.rotary_axes.items()})
+        return out
+
+    def start_position(self) -> dict[str, float]:
+        """Axes at load: ``start`` where given, else X/Y 0 clamped into the limits, Z at its top."""
+        position = {}
+        for axis, (lo, hi) in self.limits().items():
+            default = hi if axis == "Z" else min(max(0.0, lo), hi)
+            position[axis] = float((self.start or {}).get(axis, default))
+        return position
+
+    def tool(self, t: int) -> Tool | None:
+        return next((tool for tool in self.tools if tool.t == t), None)
+
+
+def _describe(error: ValidationError) -> str:
+    parts = []
+    for item in error.errors():
+        loc = ".".join(str(p) for p in item["loc"]) or "scenario"
+        parts.append(f"{loc}: {item['msg']}")
+    return "invalid scenario: " + "; ".join(parts)
+
+
+def load_scenario(data: dict) -> Scenario:
+    """Validate a scenario dict; bad input raises ValueError naming the field(s)."""
+    if not isinstance(data, dict):
+        raise ValueError(f"invalid scenario: expected a JSON object, got {type(data).__name__}")
+    try:
+        scenario = Scenario.model_validate(data)
+    except ValidationError as exc:
+        raise ValueError(_describe(exc)) from None
+    _check_finite(scenario)
+    return scenario
+
+
+def _check_finite(scenario: Scenario) -> None:
+    # seed/int fields aside, every number must be finite (pydantic checks the annotated ones)
+    for axis, (lo, hi) in scenario.limits().items():
+        if not (math.isfinite(lo) and math.isfinite(hi)):
+            raise ValueError(f"invalid scenario: limits.{axis} must be finite")
+
+
+def demo_scenario() -> Scenario:
+    """The built-in demo: a rotated block with hole, pocket, spigot and boss, gauges, two cutters."""
+    return load_scenario(json.loads(DEMO_SCENARIO_PATH.read_text(encoding="utf-8")))
