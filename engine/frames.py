@@ -39,6 +39,14 @@ def rot_z(deg: float) -> np.ndarray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
+def rot_axis(axis: str, deg: float) -> np.ndarray:
+    """Right-hand rotation about the geometry axis ``axis`` ("X", "Y", "Z") (measuring-math §0.1)."""
+    try:
+        return {"X": rot_x, "Y": rot_y, "Z": rot_z}[axis](deg)
+    except KeyError:
+        raise ValueError(f"axis must be X, Y or Z, got {axis!r}") from None
+
+
 def matrix_from_rpy(rot_deg) -> np.ndarray:
     """R = Rz(c)·Ry(b)·Rx(a) for rot_deg = (a about X, b about Y, c about Z) (design.md §3 RPY)."""
     a, b, c = _vec3(rot_deg, "rot_deg")
@@ -51,12 +59,18 @@ def rpy_from_matrix(matrix) -> np.ndarray:
     if r.shape != (3, 3):
         raise ValueError(f"rotation matrix must have shape (3, 3), got {r.shape}")
     b = np.arcsin(np.clip(-r[2, 0], -1.0, 1.0))
-    a = np.arctan2(r[2, 1], r[2, 2])
-    c = np.arctan2(r[1, 0], r[0, 0])
+    if abs(r[2, 0]) > 1.0 - 1e-12:
+        # gimbal lock (b = ±90°): only a ∓ c is defined; choose c = 0
+        # (Rz(0)·Ry(±90)·Rx(a) has R[0,1] = ±sin a, R[1,1] = cos a)
+        a = np.arctan2(np.sign(-r[2, 0]) * r[0, 1], r[1, 1])
+        c = 0.0
+    else:
+        a = np.arctan2(r[2, 1], r[2, 2])
+        c = np.arctan2(r[1, 0], r[0, 0])
     return np.degrees(np.array([a, b, c]))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Frame:
     """One frame: coarse + fine translation, RPY rotation (deg), rotary-axis offsets (deg).
 
@@ -103,6 +117,32 @@ class Frame:
 
     def rotary_offset(self, axis: str) -> float:
         return dict(self.rotary).get(axis, 0.0)
+
+    def with_rotary(self, axis: str, value: float) -> Frame:
+        """Copy with the rotary-axis offset ``axis`` set to ``value`` (deg)."""
+        rotary = dict(self.rotary)
+        rotary[axis] = float(value)
+        return self.replace(rotary=tuple(rotary.items()))
+
+    # --- comparison (numpy fields: the generated dataclass __eq__ would raise) ----------
+    def _key(self) -> tuple:
+        return (tuple(self.coarse), tuple(self.fine), tuple(self.rot), self.rotary)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Frame):
+            return NotImplemented
+        return self._key() == other._key()
+
+    def __hash__(self) -> int:
+        return hash(self._key())
+
+    def isclose(self, other: Frame, tol: float = 1e-9) -> bool:
+        """Same mapping and bookkeeping within ``tol`` (mm for translations, deg for angles)."""
+        keys = {k for k, _ in self.rotary} | {k for k, _ in other.rotary}
+        return bool(np.allclose(self.coarse, other.coarse, rtol=0.0, atol=tol)
+                    and np.allclose(self.fine, other.fine, rtol=0.0, atol=tol)
+                    and np.allclose(self.rotation, other.rotation, rtol=0.0, atol=tol)
+                    and all(abs(self.rotary_offset(k) - other.rotary_offset(k)) <= tol for k in keys))
 
     @property
     def is_identity(self) -> bool:
@@ -205,3 +245,18 @@ class FrameChain:
 
     def p_in_wcs(self, p_in_bcs) -> np.ndarray:
         return self.wcs2bcs.parent2child(p_in_bcs)
+
+    def dir_in_bcs(self, d_in_wcs) -> np.ndarray:
+        return self.wcs2bcs.dir_child2parent(d_in_wcs)
+
+    def parent2bcs_of_basic(self, index: int) -> Frame:
+        """Frames outside basic frame ``index`` (SETFRAME ∘ BASIC_0 ∘ … ∘ BASIC_{index-1})."""
+        if not 0 <= index < len(self.basic):
+            raise ValueError(f"basic frame {index} does not exist (have {len(self.basic)})")
+        return compose_chain([self.setframe, *self.basic[:index]])
+
+    def replace(self, **changes) -> FrameChain:
+        values = {"setframe": self.setframe, "basic": self.basic, "settable": self.settable}
+        values.update(changes)
+        values["basic"] = tuple(values["basic"])
+        return FrameChain(**values)

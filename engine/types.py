@@ -114,6 +114,11 @@ class FeatureFix:
     angle_axis: str | None = None
     reference_axis: str | None = None
     normal: np.ndarray | None = None
+    # full 3D reference point in the measuring WCS (e.g. the surface point of set edge, the
+    # corner/centre at measuring height); its undetermined components place the feature when
+    # the target system is rotated against the measuring WCS (jog-measuring §2.5.1 [I] uses
+    # the 3D contact point). ``position`` overrides its determined axes. None = zeros.
+    point: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -151,6 +156,7 @@ class ProbeStep:
     feed: float
     coords: str = "WCS"
     label: str = ""
+    expected: float | None = None   # travel at which the nominal geometry switches (preview only)
 
 
 @dataclass(frozen=True)

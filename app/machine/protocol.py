@@ -19,7 +19,8 @@ import numpy as np
 ALARM_PROBE_NOT_SWITCHED = 61301
 ALARM_PROBE_COLLISION = 61302
 ALARM_LIMIT = 21614            # "software limit switch" style alarm of the NC
-ALARM_PROBE_BROKEN = 61303     # overtravel beyond the probe's permissible deflection
+ALARM_PROBE_BROKEN = 61302     # overtravel beyond the permissible deflection (measuring-math §1.3);
+                               # same number as a collision, but not resettable
 ALARM_RESET = 16900            # motion aborted by Reset (informational, cleared by Reset)
 
 

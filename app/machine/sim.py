@@ -6,11 +6,11 @@ time so that ``status()`` from another thread sees the axes move. The lock is ne
 while sleeping.
 
 Decisions (where the spec leaves room):
-- A broken probe (61303, not resettable) refuses every motion (probe, goto, jog) while it is
+- A broken probe (61302 per measuring-math §1.3, not resettable) refuses every motion (probe, goto, jog) while it is
   in the spindle; Reset does not repair it, a tool change (any tool, also the same T = new
   stylus) or ``load()`` does.
 - A switch during goto/jog is a collision (61302); if the overtravel behind the first contact
-  then exceeds ``max_deflection`` the probe also breaks (61303): a rapid move into the part
+  then exceeds ``max_deflection`` the probe also breaks (61302, not resettable): a rapid move into the part
   breaks the stylus, as on a real machine.
 - Active alarms do not lock the axes (the operator may jog away before pressing Reset).
 - Limits: a move whose end lies outside the limits is refused before moving: the limit
@@ -152,7 +152,7 @@ class SimulatedMachine:
             self._tool = tool
             self._offset_length = offset_length
             self._probe_broken = False
-            self._alarms = [a for a in self._alarms if a.code != ALARM_PROBE_BROKEN]
+            self._alarms = [a for a in self._alarms if a.resettable or a.code != ALARM_PROBE_BROKEN]
 
     def set_tool_offset(self, offset_length: float) -> None:
         with self._lock:
@@ -409,7 +409,7 @@ class SimulatedMachine:
             if self._busy:
                 raise MachineBusy("a motion is already running")
             if self._probe_broken and self._probe_in_spindle():
-                alarm = next((a for a in self._alarms if a.code == ALARM_PROBE_BROKEN), None)
+                alarm = next((a for a in self._alarms if a.code == ALARM_PROBE_BROKEN and not a.resettable), None)
                 raise MachineAlarm(alarm or self._break_probe())
             self._busy = True
             self._abort.clear()
