@@ -1,0 +1,226 @@
+"""Planning contracts and the common probing execution (spec/jog-measuring.md §2.4).
+
+``PlanContext``, ``TASK_POINTS``, ``ParamError``, the stored points of calibration and tool
+tasks, and ``Motion``: the positioning/probing helper every point program uses. Re-exported
+by ``engine.plan`` (the public module).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Generator, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from engine.planes import Plane
+from engine.types import Latch, MeasuringError, MoveStep, ProbeRecord, ProbeStep, SpindleStep, Step
+
+TWO_STAGE_RETRACT = 2.0   # mm back after the fast first touch (spec §2.4 step 3, §8.4 _SPEED[3])
+
+
+@dataclass(frozen=True)
+class PlanContext:
+    plane: Plane
+    probe: ProbeRecord
+    skew_wcs: np.ndarray            # from compensation.skew_in_wcs
+    measuring_feed: float = 300.0   # E_MESS_FM
+    position_feed: float = 2000.0   # E_MESS_F (plane)
+    position_feed_infeed: float = 2000.0  # E_MESS_FZ
+    measuring_path: float = 50.0    # E_MESS_D_M
+    attempts: int = 1               # 1 (_JM_B[1]=1) or 5
+    fast_feed: float | None = None  # _SPEED[3] when _JM_B[3]=1 (two-stage), else None
+    rapid_return: bool = False      # _JM_B[2]
+    spigot_safety: float = 5.0
+    # --- tool measuring (spec §7, §8.3 GUD7 E_MESS_MT_*; tool probe record _TP[n] §8.4) -----
+    tool_probe: dict[str, float] | None = None  # _TP[n,0..4] by travel key "X-","X+","Y-","Y+","Z-" (MCS, tool edge)
+    tool_radius: float = 0.0        # active tool R (geometry + wear) as the NC knows it
+    tool_length: float = 0.0        # active tool L1 the NC uses for the tip (informative)
+    mt_axes: int = 133              # E_MESS_MT_AX digit code (units X, tens Y, hundreds Z)
+    mt_diameter_length: float = 0.0  # E_MESS_MT_DL: probe width for length measuring
+    mt_diameter_radius: float = 0.0  # E_MESS_MT_DR: probe width for radius measuring
+    mt_dz: float = 2.0              # E_MESS_MT_DZ: tool lower edge below the probe's upper edge
+    mt_dir: int = -1                # E_MESS_MT_DIR: approach along -1st (−1) / +1st (+1) axis
+    mt_path: float = 10.0           # E_MESS_MT_D: calibration / rotating-spindle measuring path
+    mt_feed: float = 100.0          # E_MESS_MT_FM
+    path_length: float = 2.0        # E_MESS_D_L (stationary length; fine-stage path)
+    path_radius: float = 1.0        # E_MESS_D_R (stationary radius; fine-stage path)
+    max_surface_speed: float = 100.0  # E_MESS_MAX_V [m/min]
+    max_spindle_speed: float = 1000.0  # E_MESS_MAX_S [rpm]
+    max_feed_rotating: float = 20.0  # E_MESS_MAX_F
+    min_feed_rotating: float = 1.0   # E_MESS_MIN_F
+    feed_factor1: float = 10.0      # E_MESS_F_FAK1
+    feed_factor2: float = 0.0       # E_MESS_F_FAK2
+    min_accuracy: float = 0.01      # E_MESS_MIN_D
+
+
+TASK_POINTS: dict[str, int] = {
+    "edge.set": 1, "edge.align": 2, "edge.distance": 2,
+    "corner.right": 3, "corner.any": 4,
+    "pocket.rect": 1, "hole.1": 1, "hole.2": 2, "hole.3": 3, "hole.4": 4,
+    "spigot.rect": 1, "spigot.1": 1, "spigot.2": 2, "spigot.3": 3, "spigot.4": 4,
+    "plane.align": 3,
+    "probe.length": 1, "probe.radius": 1,
+    "toolprobe.calibrate": 1, "tool.length": 1, "tool.diameter": 1,
+}
+
+
+class ParamError(ValueError):
+    """An invalid task parameter; ``field`` names it, the message names the problem."""
+
+    def __init__(self, field: str, message: str):
+        super().__init__(message)
+        self.field = field
+        self.message = message
+
+
+# --- stored points of calibration and tool tasks (raw data in, not results) ---------------
+
+@dataclass(frozen=True)
+class RingPass:
+    """One 4-direction pass in the ring gauge (spec §5.3): raw recs (WCS, no skew, no triggers).
+
+    ``rec``/``latched_mcs`` keyed by travel direction "X+", "X-", ... (+1st, −1st, +2nd, −2nd).
+    """
+
+    spindle_angle: float
+    rec: dict[str, np.ndarray]
+    latched_mcs: dict[str, np.ndarray | None] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class RingCalibrationPoint:
+    """probe.radius: ring diameter, centre search (spindle 0°) and the passes at 180° then 0°."""
+
+    diameter: float
+    search: RingPass
+    passes: tuple[RingPass, ...]    # (SPOS 180°, SPOS 0°) — measuring-math §7.3 m180, m0
+
+
+@dataclass(frozen=True)
+class ToolTouch:
+    """One tool-probe touch: tool tip (MCS) at switching; ``key`` = travel direction "Z-", "X+"."""
+
+    key: str
+    rec: np.ndarray
+    latched_mcs: np.ndarray | None = None
+    feed: float = 0.0
+
+
+@dataclass(frozen=True)
+class ToolProbePoint:
+    """toolprobe.calibrate: touches in probing order (the final "Z-" at the found centre last).
+
+    ``tool_radius``/``tool_length``: the calibration tool's data used (spec §7.2 formulas).
+    """
+
+    mode: str
+    touches: tuple[ToolTouch, ...]
+    tool_radius: float
+    tool_length: float
+
+
+@dataclass(frozen=True)
+class ToolPoint:
+    """tool.length / tool.diameter: the final (finest) touch and how it was made (spec §7.3)."""
+
+    kind: str                      # "length" | "radius"
+    touch: ToolTouch               # final touch (L1 = F_z − _TP[n,4]; R = F_a − _TP[n,0] ...)
+    rotating: bool
+    speed: float                   # rpm, 0 = stationary
+    feeds: tuple[float, ...]       # feeds of the probing stages, last = final
+    offset_v: float
+    lateral_offset: float          # length: tool axis offset from the probe centre along +1st
+    tool_radius: float
+    tool_length: float
+
+
+# --- common probing execution -------------------------------------------------------------
+
+def hit(latch: Latch | None) -> bool:
+    return latch is not None and latch.triggered and latch.rec is not None
+
+
+class Motion:
+    """Tracks the NC reference position and builds steps (spec §2.4 steps 2, 3, 5, 6).
+
+    Targets are NC reference positions in ``coords`` (WCS: ball centre/tip as the NC knows it;
+    MCS: tool tip). ``ball_offset`` = true ball centre − NC reference (skew, §1.3 / math §5.2):
+    ``to_ball`` commands the reference so that the *ball* reaches a point.
+    """
+
+    def __init__(self, start, ctx: PlanContext, coords: str = "WCS", ball_offset=None):
+        self.pos = np.asarray(start, dtype=float).copy()
+        self.start = self.pos.copy()
+        self.ctx = ctx
+        self.coords = coords
+        self.ball_offset = np.zeros(3) if ball_offset is None else np.asarray(ball_offset, float)
+
+    def feed_for(self, target: np.ndarray) -> float:
+        """E_MESS_FZ for pure infeed-axis moves, else E_MESS_F (spec §2.4 step 1)."""
+        delta = target - self.pos
+        p = self.ctx.plane.infeed_unit
+        in_plane = delta - float(delta @ p) * p
+        if np.linalg.norm(in_plane) <= 1e-12 and abs(float(delta @ p)) > 0.0:
+            return self.ctx.position_feed_infeed
+        return self.ctx.position_feed
+
+    def move(self, target, label: str = "", feed: float | None | str = "auto") -> list[Step]:
+        """Monitored intermediate positioning (61302 on a switch, spec §2.4 step 2)."""
+        target = np.asarray(target, dtype=float)
+        if np.allclose(target, self.pos, rtol=0.0, atol=1e-12):
+            return []
+        f = self.feed_for(target) if feed == "auto" else feed
+        self.pos = target.copy()
+        return [MoveStep(target=target.copy(), feed=f, monitored=True, coords=self.coords, label=label)]
+
+    def to_ball(self, ball_target, label: str = "") -> list[Step]:
+        return self.move(np.asarray(ball_target, float) - self.ball_offset, label)
+
+    def back(self, target, label: str = "return") -> list[Step]:
+        """Return move: rapid with _JM_B[2]=1, else positioning feed (spec §2.4 step 6)."""
+        target = np.asarray(target, dtype=float)
+        feed = None if self.ctx.rapid_return else "auto"
+        return self.move(target, label, feed)
+
+    def probe(self, direction, distance: float, label: str, *, expected: float | None = None,
+              feeds: Sequence[float] | None = None, fine_retract: float = TWO_STAGE_RETRACT
+              ) -> Generator[Step, Latch | None, Latch]:
+        """Probe from the current position; retries and multi-stage probing (spec §2.4 3–5).
+
+        ``feeds`` default: [_SPEED[3], E_MESS_FM] with _JM_B[3]=1, else [E_MESS_FM]. Every later
+        stage retracts ``fine_retract`` against the travel from the latched position and probes
+        over 2·fine_retract. No switch (in any stage): back to the stroke start and retry, up to
+        ``ctx.attempts`` (_JM_B[1]); then 61301.
+        """
+        d = np.asarray(direction, dtype=float)
+        if feeds is None:
+            ctx = self.ctx
+            feeds = [ctx.fast_feed, ctx.measuring_feed] if ctx.fast_feed else [ctx.measuring_feed]
+        origin = self.pos.copy()
+        for attempt in range(max(1, int(self.ctx.attempts))):
+            if attempt:
+                yield from self.move(origin, f"{label} retry {attempt + 1}")
+            latch = yield ProbeStep(direction=d.copy(), distance=float(distance), feed=float(feeds[0]),
+                                    coords=self.coords, label=label, expected=expected)
+            if not hit(latch):
+                self.pos = origin + float(distance) * d
+                continue
+            self.pos = np.asarray(latch.rec, dtype=float).copy()
+            for stage, f in enumerate(feeds[1:], start=2):
+                yield from self.move(latch.rec - fine_retract * d, f"{label} retract")
+                fine = yield ProbeStep(direction=d.copy(), distance=2.0 * fine_retract, feed=float(f),
+                                       coords=self.coords, label=f"{label} stage {stage}",
+                                       expected=fine_retract)
+                if not hit(fine):
+                    self.pos = self.pos + 2.0 * fine_retract * d
+                    latch = None
+                    break
+                latch = fine
+                self.pos = np.asarray(latch.rec, dtype=float).copy()
+            if latch is not None:
+                return latch
+        raise MeasuringError(61301, "Probe not switched")
+
+
+def spindle(angle: float | None = None, speed: float | None = None, label: str = "") -> SpindleStep:
+    return SpindleStep(angle=angle, speed=speed, label=label)
