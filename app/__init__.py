@@ -1,0 +1,1 @@
+"""The Measure-in-JOG HMI application (FastAPI, Jinja2 + htmx)."""

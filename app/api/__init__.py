@@ -1,0 +1,11 @@
+"""JSON API routers (design.md §4). Thin: parse, call a service, return its data."""
+
+from fastapi import APIRouter
+
+from . import data, machine
+
+api_router = APIRouter(prefix="/api")
+api_router.include_router(machine.router)
+api_router.include_router(data.router)
+
+__all__ = ["api_router"]

@@ -1,0 +1,115 @@
+"""Error envelope ``{"error": {"code", "message", "field"?}}`` and the exception handlers (design.md §4).
+
+Services raise :class:`HmiError` subclasses; routers never build error responses themselves.
+"""
+
+from __future__ import annotations
+
+import logging
+
+from fastapi import FastAPI, Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import JSONResponse
+from starlette.exceptions import HTTPException as StarletteHTTPException
+
+from app.machine.protocol import MachineAlarm, MachineBusy
+
+log = logging.getLogger(__name__)
+
+
+class HmiError(Exception):
+    status = 400
+    code = "bad_request"
+
+    def __init__(self, message: str, field: str | None = None, code: str | None = None):
+        super().__init__(message)
+        self.message = message
+        self.field = field
+        if code:
+            self.code = code
+
+
+class NotFoundError(HmiError):
+    status = 404
+    code = "not_found"
+
+
+class InvalidInput(HmiError):
+    status = 422
+    code = "validation"
+
+
+class ConflictError(HmiError):
+    status = 409
+    code = "conflict"
+
+
+class BusyError(ConflictError):
+    code = "busy"
+
+
+class AlarmError(ConflictError):
+    """A motion stopped by a machine alarm; the alarm stays in the machine status until Reset."""
+
+    code = "alarm"
+
+    def __init__(self, alarm_code: int, text: str):
+        super().__init__(f"{alarm_code} {text}")
+        self.alarm_code = alarm_code
+
+
+def envelope(code: str, message: str, field: str | None = None) -> dict:
+    body = {"code": code, "message": message}
+    if field:
+        body["field"] = field
+    return {"error": body}
+
+
+def error_response(status: int, code: str, message: str, field: str | None = None) -> JSONResponse:
+    return JSONResponse(envelope(code, message, field), status_code=status)
+
+
+def field_path(loc) -> str:
+    """Pydantic location -> dotted field name without the ``body``/``query`` prefix."""
+    parts = [str(p) for p in loc if p not in ("body", "query", "path", "form")]
+    return ".".join(parts)
+
+
+def _validation_message(err: dict) -> str:
+    msg = err.get("msg", "invalid value")
+    return msg.removeprefix("Value error, ")
+
+
+def install_handlers(app: FastAPI) -> None:
+    @app.exception_handler(HmiError)
+    async def _hmi_error(_: Request, exc: HmiError):
+        return error_response(exc.status, exc.code, exc.message, exc.field)
+
+    @app.exception_handler(MachineAlarm)
+    async def _machine_alarm(_: Request, exc: MachineAlarm):
+        return error_response(409, "alarm", f"{exc.alarm.code} {exc.alarm.text}")
+
+    @app.exception_handler(MachineBusy)
+    async def _machine_busy(_: Request, exc: MachineBusy):
+        return error_response(409, "busy", str(exc) or "a motion is running")
+
+    @app.exception_handler(RequestValidationError)
+    async def _request_validation(_: Request, exc: RequestValidationError):
+        errors = exc.errors()
+        first = errors[0] if errors else {}
+        field = field_path(first.get("loc", ())) or None
+        message = _validation_message(first) if first else "invalid request"
+        if field:
+            message = f"{field}: {message}"
+        return error_response(422, "validation", message, field)
+
+    @app.exception_handler(StarletteHTTPException)
+    async def _http_error(_: Request, exc: StarletteHTTPException):
+        code = {404: "not_found", 405: "method_not_allowed"}.get(exc.status_code, "http_error")
+        return error_response(exc.status_code, code, str(exc.detail))
+
+    @app.exception_handler(ValueError)
+    async def _value_error(_: Request, exc: ValueError):
+        # A ValueError escaping a service is bad input the service did not name (e.g. numpy/engine).
+        log.info("unclassified ValueError: %s", exc)
+        return error_response(422, "validation", str(exc))

@@ -1,0 +1,33 @@
+"""Services: orchestrate the machine, the engine and the db. Routers stay thin and call these.
+
+``Services`` is the container the app builds once (``app.state.services``); routers get the
+parts through the ``Annotated`` dependencies in ``app.deps``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from db import Database
+
+from .log import LogService
+from .machine_service import MachineService
+from .offsets import OffsetService
+from .probes import ProbeService, ToolProbeService
+from .settings import SettingsService
+from .tools import ToolService
+
+
+@dataclass
+class Services:
+    db: Database
+    settings: SettingsService
+    machine: MachineService
+    offsets: OffsetService
+    tools: ToolService
+    probes: ProbeService
+    tool_probes: ToolProbeService
+    log: LogService
+
+
+__all__ = ["LogService", "MachineService", "OffsetService", "ProbeService", "Services", "ToolProbeService", "SettingsService", "ToolService"]

@@ -1,0 +1,103 @@
+"""The GUD measuring settings: stored in the db, validated by ``app.gud.GudSettings``."""
+
+from __future__ import annotations
+
+import threading
+
+from pydantic import ValidationError
+
+from app.errors import InvalidInput
+from app.gud import GudSettings
+from db import Database
+
+
+def raise_invalid(error: ValidationError, prefix: str = "") -> None:
+    """First pydantic error -> InvalidInput naming the field (``prefix`` + location)."""
+    first = error.errors()[0]
+    field = prefix + ".".join(str(p) for p in first["loc"])
+    message = first["msg"].removeprefix("Value error, ")
+    raise InvalidInput(f"{field}: {message}" if field else message, field=field or None) from None
+
+
+def validation_errors(error: ValidationError) -> dict[str, str]:
+    """All pydantic errors as {field: message}, for forms that mark every bad field."""
+    out: dict[str, str] = {}
+    for item in error.errors():
+        field = ".".join(str(p) for p in item["loc"])
+        out.setdefault(field, item["msg"].removeprefix("Value error, "))
+    return out
+
+
+class SettingsService:
+    def __init__(self, db: Database):
+        self._db = db
+        self._lock = threading.Lock()
+        self._cached: GudSettings | None = None
+
+    def get(self) -> GudSettings:
+        """Stored values over the defaults; unknown or stale stored keys are ignored."""
+        with self._lock:
+            if self._cached is None:
+                with self._db.unit(readonly=True) as unit:
+                    stored = unit.get_settings()
+                self._cached = _lenient(stored)
+            return self._cached
+
+    def validate(self, values: dict) -> GudSettings:
+        """Current settings with ``values`` applied; InvalidInput names the first bad field."""
+        if not isinstance(values, dict):
+            raise InvalidInput("settings must be an object")
+        merged = {**self.get().model_dump(), **values}
+        try:
+            settings = GudSettings.model_validate(merged)
+        except ValidationError as error:
+            raise_invalid(error)
+        self._check_wo(settings)
+        return settings
+
+    def check(self, values: dict) -> tuple[GudSettings | None, dict[str, str]]:
+        """Like ``validate`` but collects every bad field (for the settings form)."""
+        merged = {**self.get().model_dump(), **values}
+        try:
+            settings = GudSettings.model_validate(merged)
+        except ValidationError as error:
+            return None, validation_errors(error)
+        try:
+            self._check_wo(settings)
+        except InvalidInput as error:
+            return None, {error.field or "": error.message}
+        return settings, {}
+
+    def put(self, values: dict) -> GudSettings:
+        settings = self.validate(values)
+        with self._lock:
+            with self._db.unit() as unit:
+                unit.put_settings(settings.model_dump())
+            self._cached = settings
+        return settings
+
+    def reset_to_defaults(self) -> GudSettings:
+        return self.put(GudSettings().model_dump())
+
+    def _check_wo(self, settings: GudSettings) -> None:
+        if settings.measuring_wo in ("G500", "active"):
+            return
+        with self._db.unit(readonly=True) as unit:
+            names = unit.offset_names()
+        if settings.measuring_wo not in names:
+            raise InvalidInput(f"measuring_wo: {settings.measuring_wo} is not a configured zero offset",
+                               field="measuring_wo")
+
+
+def _lenient(stored: dict) -> GudSettings:
+    defaults = GudSettings()
+    values = {}
+    for key, value in stored.items():
+        if key not in GudSettings.model_fields:
+            continue
+        try:
+            GudSettings.model_validate({**defaults.model_dump(), key: value})
+        except ValidationError:
+            continue
+        values[key] = value
+    return GudSettings.model_validate({**defaults.model_dump(), **values})

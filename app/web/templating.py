@@ -1,0 +1,89 @@
+"""Jinja2 + jinja2-fragments: full page on a normal GET, only the screen blocks on an htmx request.
+
+A screen template extends ``base.html`` and fills ``content`` and ``vkeys``; ``render_screen``
+returns the blocks ``screen``, ``vsoftkeys`` and ``hsoftkeys`` (the last two swap out of band).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import jinja2_fragments
+from fastapi import Request
+from fastapi.responses import HTMLResponse
+from jinja2_fragments.fastapi import Jinja2Blocks
+
+from app.gud import GudSettings
+
+TEMPLATES_DIR = Path(__file__).resolve().parents[2] / "templates"
+SCREEN_BLOCKS = ["screen", "vsoftkeys", "hsoftkeys"]
+
+# Horizontal softkeys F1..F8 (design.md §7); None = an empty key.
+HORIZONTAL_SOFTKEYS: list[tuple[str, str, str] | None] = [
+    ("measure_workpiece", "Measure workpiece", "/measure/workpiece"),
+    ("measure_tool", "Measure tool", "/measure/tool"),
+    ("offsets", "Zero offset", "/offsets"),
+    ("tools", "Tool list", "/tools"),
+    ("machine_view", "Machine view", "/machine-view"),
+    ("settings", "Settings", "/settings"),
+    None,
+    ("jog", "JOG", "/jog"),
+]
+
+INCH = 25.4
+
+
+def fmt_length(value: float | None, gud: GudSettings, rotary: bool = False) -> str:
+    """Display a stored mm value: 3 decimals in mm, 4 in inch; rotary axes in degrees."""
+    if value is None:
+        return ""
+    if rotary:
+        return f"{value:.3f}"
+    if gud.inch_display:
+        return f"{value / INCH:.4f}"
+    return f"{value:.3f}"
+
+
+templates = Jinja2Blocks(directory=str(TEMPLATES_DIR))
+templates.env.globals["HORIZONTAL_SOFTKEYS"] = HORIZONTAL_SOFTKEYS
+templates.env.filters["mm"] = fmt_length
+# macros as a global module, so blocks rendered on their own (htmx partials) can call them
+templates.env.globals["ui"] = templates.env.get_template("macros.html").module
+
+
+def is_htmx(request: Request) -> bool:
+    return request.headers.get("HX-Request") == "true" and "HX-History-Restore-Request" not in request.headers
+
+
+def base_context(request: Request) -> dict:
+    services = request.app.state.services
+    machine = services.machine
+    return {
+        "status": machine.status(),
+        "panel": machine.panel,
+        "axes": machine.axes,
+        "rotary_axes": machine.rotary_axes,
+        "gud": services.settings.get(),
+    }
+
+
+def _owner(template: str, block: str) -> str:
+    """The template that defines ``block``: the screen's own, else the layout's default."""
+    return template if block in templates.get_template(template).blocks else "base.html"
+
+
+def render_screen(request: Request, template: str, context: dict | None = None, status_code: int = 200):
+    """Full page on a normal GET; on an htmx request the blocks screen + vsoftkeys + hsoftkeys."""
+    ctx = {"request": request, **base_context(request), **(context or {})}
+    if not is_htmx(request):
+        return templates.TemplateResponse(request, template, ctx, status_code=status_code)
+    html = "".join(jinja2_fragments.render_block(templates.env, _owner(template, block), block, ctx)
+                   for block in SCREEN_BLOCKS)
+    return HTMLResponse(html, status_code=status_code)
+
+
+def render_block(request: Request, template: str, block: str, context: dict | None = None,
+                 status_code: int = 200, headers: dict | None = None):
+    ctx = {"request": request, **base_context(request), **(context or {})}
+    html = jinja2_fragments.render_block(templates.env, _owner(template, block), block, ctx)
+    return HTMLResponse(html, status_code=status_code, headers=headers)

@@ -1,0 +1,101 @@
+"""Fixtures: an app on a tmp db with a time_scale-0 test scenario, a live server and Chromium."""
+
+from __future__ import annotations
+
+import json
+import socket
+import threading
+import time
+
+import pytest
+from fastapi.testclient import TestClient
+from hmi_testdata import TEST_SCENARIO, test_scenario
+
+CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                 "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+
+
+@pytest.fixture
+def scenario_file(tmp_path):
+    path = tmp_path / "scenario.json"
+    path.write_text(json.dumps(TEST_SCENARIO))
+    return path
+
+
+@pytest.fixture
+def app(tmp_path, scenario_file):
+    # imported here so a broken app never stops the db/engine/sim tests from being collected
+    from app.config import Settings
+    from app.main import create_app
+
+    return create_app(Settings(db_path=tmp_path / "hmi.db", scenario_path=scenario_file))
+
+
+@pytest.fixture
+def client(app):
+    with TestClient(app) as test_client:
+        yield test_client
+
+
+# --- end to end -------------------------------------------------------------------------
+
+def _free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+@pytest.fixture(scope="session")
+def live_server(tmp_path_factory):
+    """The app served by uvicorn in a thread; yields its base URL."""
+    import uvicorn
+
+    from app.config import Settings
+    from app.main import create_app
+
+    root = tmp_path_factory.mktemp("live")
+    scenario = root / "scenario.json"
+    scenario.write_text(json.dumps(TEST_SCENARIO))
+    port = _free_port()
+    app = create_app(Settings(db_path=root / "hmi.db", scenario_path=scenario, port=port))
+    server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
+    thread = threading.Thread(target=server.run, daemon=True)
+    thread.start()
+    deadline = time.monotonic() + 15
+    while not server.started:
+        if time.monotonic() > deadline:
+            raise RuntimeError("live server did not start")
+        time.sleep(0.05)
+    yield f"http://127.0.0.1:{port}"
+    server.should_exit = True
+    thread.join(timeout=5)
+
+
+@pytest.fixture(scope="session")
+def browser():
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as playwright:
+        chromium = playwright.chromium.launch(executable_path="/usr/bin/chromium", args=CHROMIUM_ARGS)
+        yield chromium
+        chromium.close()
+
+
+@pytest.fixture
+def page(browser, live_server):
+    context = browser.new_context(viewport={"width": 1280, "height": 720}, base_url=live_server)
+    context.set_default_timeout(5000)
+    tab = context.new_page()
+    yield tab
+    context.close()
+
+
+@pytest.fixture
+def api(live_server):
+    """An HTTP client on the live server, with the machine and data reset to the test scenario."""
+    import httpx
+
+    with httpx.Client(base_url=live_server, timeout=10) as http:
+        response = http.post("/api/sim/scenario", json={**test_scenario(), "reset_data": True})
+        assert response.status_code == 200, response.text
+        yield http
