@@ -16,6 +16,7 @@ from app.services import (
     ToolProbeService,
     ToolService,
 )
+from app.workflow.service import WorkflowService
 
 
 def get_services(request: Request) -> Services:
@@ -60,3 +61,10 @@ ProbesDep = Annotated[ProbeService, Depends(_probes)]
 ToolProbesDep = Annotated[ToolProbeService, Depends(_tool_probes)]
 SettingsDep = Annotated[SettingsService, Depends(_settings)]
 LogDep = Annotated[LogService, Depends(_log)]
+
+
+def _workflow(services: ServicesDep) -> WorkflowService:
+    return services.workflow
+
+
+WorkflowDep = Annotated[WorkflowService, Depends(_workflow)]

@@ -13,6 +13,8 @@ from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from app.machine.protocol import MachineAlarm, MachineBusy
+from app.workflow.service import WorkflowError
+from engine.types import MeasuringError
 
 log = logging.getLogger(__name__)
 
@@ -84,6 +86,14 @@ def install_handlers(app: FastAPI) -> None:
     @app.exception_handler(HmiError)
     async def _hmi_error(_: Request, exc: HmiError):
         return error_response(exc.status, exc.code, exc.message, exc.field)
+
+    @app.exception_handler(WorkflowError)
+    async def _workflow_error(_: Request, exc: WorkflowError):
+        return error_response(exc.status, exc.code, exc.message, exc.field)
+
+    @app.exception_handler(MeasuringError)
+    async def _measuring_error(_: Request, exc: MeasuringError):
+        return error_response(409, "alarm", f"{exc.alarm} {exc.message}")
 
     @app.exception_handler(MachineAlarm)
     async def _machine_alarm(_: Request, exc: MachineAlarm):

@@ -23,8 +23,10 @@ from app.services import (
     ToolProbeService,
     ToolService,
 )
+from app.services.measuring import MeasuringEnv
 from app.services.scenarios import read_scenario
 from app.web import web_router
+from app.workflow.registry import build_workflow
 from db import Database
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -35,11 +37,13 @@ def build_services(settings: Settings, scenario: Scenario) -> Services:
     db = Database(settings.db_path, rotary_axes=tuple(a for a in scenario.axes if a not in "XYZ"))
     gud = SettingsService(db)
     machine = MachineService(db, SimulatedMachine(scenario), scenario, gud)
-    return Services(
+    services = Services(
         db=db, settings=gud, machine=machine,
         offsets=OffsetService(db, machine), tools=ToolService(db, machine),
         probes=ProbeService(db), tool_probes=ToolProbeService(db), log=LogService(db),
     )
+    services.workflow = build_workflow(MeasuringEnv(db, machine, gud))
+    return services
 
 
 def create_app(settings: Settings | None = None) -> FastAPI:

@@ -2,10 +2,11 @@
 
 from fastapi import APIRouter
 
-from . import data, machine
+from . import data, machine, measure
 
 api_router = APIRouter(prefix="/api")
 api_router.include_router(machine.router)
 api_router.include_router(data.router)
+api_router.include_router(measure.router)
 
 __all__ = ["api_router"]

@@ -129,6 +129,9 @@ class Machine(Protocol):
     def reset(self) -> None:
         """Abort any motion and clear resettable alarms."""
 
+    def post_alarm(self, alarm: Alarm) -> None:
+        """Show an alarm raised by a measuring cycle (61301, 61367..) until Reset."""
+
     @property
     def axes(self) -> tuple[str, ...]: ...
 

@@ -420,6 +420,10 @@ class SimulatedMachine:
             self._busy = False
             self._idle.notify_all()
 
+    def post_alarm(self, alarm: Alarm) -> None:
+        """An alarm raised by a measuring cycle (e.g. 61301): shown until Reset."""
+        self._raise_alarm(alarm)
+
     def _raise_alarm(self, alarm: Alarm) -> Alarm:
         with self._lock:
             if all(a.code != alarm.code or a.text != alarm.text for a in self._alarms):

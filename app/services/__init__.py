@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from app.workflow.service import WorkflowService
 from db import Database
 
 from .log import LogService
@@ -28,6 +29,7 @@ class Services:
     probes: ProbeService
     tool_probes: ToolProbeService
     log: LogService
+    workflow: WorkflowService | None = None
 
 
 __all__ = ["LogService", "MachineService", "OffsetService", "ProbeService", "Services", "ToolProbeService", "SettingsService", "ToolService"]
