@@ -8,5 +8,6 @@ api_router = APIRouter(prefix="/api")
 api_router.include_router(machine.router)
 api_router.include_router(data.router)
 api_router.include_router(measure.router)
+api_router.include_router(__import__("app.api.setup_support", fromlist=["router"]).router)
 
 __all__ = ["api_router"]

@@ -37,6 +37,17 @@ def _check_range(value: tuple[float, float], name: str) -> tuple[float, float]:
     return value
 
 
+class RotaryTable(_Model):
+    """A rotary table: the workpiece turns with ``axis`` about a vertical line through ``center``.
+
+    ``workpiece.pose`` is the part at axis position 0. DIN 66217: the table turning + turns the
+    part clockwise seen from above (the tool's motion relative to the part is right-handed).
+    """
+
+    axis: Literal["A", "B", "C"] = "C"
+    center: Vec2 = (0.0, 0.0)
+
+
 class MachineConfig(_Model):
     """Axis limits (MCS of the tool reference point), feeds and the braking model (§1.3)."""
 
@@ -48,6 +59,7 @@ class MachineConfig(_Model):
     decel: Positive = 1.0              # braking deceleration a, m/s^2
     kv: Positive = 1.0                 # position loop gain Kv, (m/min)/mm
     time_scale: NonNegative = 1.0      # 1 = real time, 0 = no waiting
+    rotary_table: RotaryTable | None = None   # the part turns with this rotary axis (vertical table)
 
     @field_validator("limits")
     @classmethod
@@ -231,6 +243,9 @@ class Scenario(_Model):
         for name in self.rotary_axes:
             if name not in ROTARY_AXIS_NAMES:
                 raise ValueError(f"rotary_axes: unknown axis {name!r}; use one of {list(ROTARY_AXIS_NAMES)}")
+        table = self.machine.rotary_table
+        if table is not None and table.axis not in self.rotary_axes:
+            raise ValueError(f"machine.rotary_table.axis {table.axis!r} must be one of rotary_axes")
         numbers = [tool.t for tool in self.tools]
         if len(set(numbers)) != len(numbers):
             raise ValueError("tools: tool numbers must be unique")

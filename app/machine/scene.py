@@ -230,14 +230,30 @@ class Scene:
         return None
 
 
-def build_scene(scenario) -> Scene:
+def workpiece_pose(scenario, table_angle: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Part -> MCS (R, t) with the rotary table at ``table_angle`` (deg; pose = the part at 0).
+
+    DIN 66217 table: +angle turns the part by −angle about the vertical table axis through
+    ``machine.rotary_table.center``: R' = Rz(−c)·R, t' = Rz(−c)·(t − centre) + centre.
+    """
+    wp = scenario.workpiece
+    rot = rpy_matrix(wp.pose.rot)
+    trans = np.asarray(wp.pose.trans, dtype=float)
+    table = scenario.machine.rotary_table
+    if table is None or table_angle == 0.0:
+        return rot, trans
+    turn = rpy_matrix((0.0, 0.0, -float(table_angle)))
+    centre = np.array([table.center[0], table.center[1], 0.0])
+    return turn @ rot, turn @ (trans - centre) + centre
+
+
+def build_scene(scenario, table_angle: float = 0.0) -> Scene:
     """The scenario's true solids (design.md §4 field meanings) as a Scene in MCS."""
     bodies: list[Body] = []
     identity = np.eye(3)
     wp = scenario.workpiece
     if wp is not None and wp.block is not None:
-        rot = rpy_matrix(wp.pose.rot)
-        trans = np.asarray(wp.pose.trans, dtype=float)
+        rot, trans = workpiece_pose(scenario, table_angle)
 
         def place(p_part) -> np.ndarray:
             return rot @ np.asarray(p_part, dtype=float) + trans

@@ -21,8 +21,9 @@ Decisions (where the spec leaves room):
   the status (Reset has just cleared the status alarms).
 - Feed override is read continuously for the motion timing; the probe physics (latency,
   braking) use the override in effect when the move starts.
-- Rotary axes are positions with limits only: the scene does not turn with them (no rotary
-  table kinematics yet).
+- Rotary axes are positions with limits; the axis named in ``machine.rotary_table`` turns the
+  workpiece (not the gauges) about the vertical table axis (scene.workpiece_pose); the part is
+  re-placed when a positioning of that axis ends (see ``_move_and_turn``).
 - Cutters: a flat-end cylinder, stationary or rotating alike (the full cylinder of radius R;
   the eccentricity of the ball probe is not smeared by rotation either). The tool probe
   contact is exact (Minkowski sum of two vertical cylinders); a cutter touching the
@@ -55,7 +56,7 @@ from .protocol import (
     ProbeResult,
 )
 from .scenario import GEOMETRY_AXES, Scenario
-from .scene import Body, Scene, build_scene, tool_probe_cylinder
+from .scene import Body, Scene, build_scene, tool_probe_cylinder, workpiece_pose
 
 ALARM_NO_TOOL = 61343         # "no tool for the given tool identifier" (spec/jog-measuring.md §10)
 TICK_S = 0.01                 # motion update period at time_scale > 0
@@ -90,6 +91,7 @@ class SimulatedMachine:
         with self._lock:
             self._scenario = scenario
             self._scene = build_scene(scenario)
+            self._table_angle = 0.0
             self._axes = scenario.axes
             self._limits = scenario.limits()
             start = scenario.start_position()
@@ -103,6 +105,7 @@ class SimulatedMachine:
             self._alarms: list[Alarm] = []
             self._probe_broken = False
             self._rng = np.random.default_rng(scenario.seed)
+            self._sync_table()
 
     def load(self, scenario: Scenario) -> None:
         """Replace the truth and reset the machine (axes to the start position, probe in spindle)."""
@@ -212,7 +215,7 @@ class SimulatedMachine:
             feed = _positive(feed, "feed")
         self._begin()
         try:
-            return self._move(target, feed, rapid=feed is None)
+            return self._move_and_turn(target, feed, rapid=feed is None)
         finally:
             self._finish()
 
@@ -225,7 +228,7 @@ class SimulatedMachine:
         try:
             target = self._pos.copy()
             target[index] += distance
-            return self._move(target, feed, rapid=False)
+            return self._move_and_turn(target, feed, rapid=False)
         finally:
             self._finish()
 
@@ -242,7 +245,7 @@ class SimulatedMachine:
 
         def run() -> None:
             try:
-                result = self._move(target, feed, rapid=False)
+                result = self._move_and_turn(target, feed, rapid=False)
                 if result.completed:   # ran onto the software limit
                     self._raise_alarm(Alarm(ALARM_LIMIT, f"Axis {axis} at software limit switch"))
             finally:
@@ -293,6 +296,38 @@ class SimulatedMachine:
             self._finish()
 
     # --- motion internals ----------------------------------------------------------------
+    def _move_and_turn(self, target: np.ndarray, feed: float | None, rapid: bool) -> MoveResult:
+        """``_move``, then the part follows the rotary table axis (scenario machine.rotary_table).
+
+        Simplification: the path is checked with the part where it stood at the start of the
+        move; a table turn that ends with the probe inside the part is a collision (61302).
+        """
+        result = self._move(target, feed, rapid)
+        if not self._sync_table():
+            return result
+        if self._probe_in_spindle():
+            probe = self._scenario.probe
+            with self._lock:
+                centre = ball_centre(self._pos[_XYZ], probe.length, probe.eccentricity, self._spindle_angle)
+            if self._scene.sdf(centre) < probe.ball_diameter / 2.0:
+                alarm = self._raise_alarm(Alarm(ALARM_PROBE_COLLISION, "Probe collision: the rotary table "
+                                                "turned the workpiece into the probe"))
+                return MoveResult(result.mcs, False, alarm)
+        return result
+
+    def _sync_table(self) -> bool:
+        """Rebuild the scene when the rotary table axis moved; True when it did."""
+        table = self._scenario.machine.rotary_table
+        if table is None or table.axis not in self._axes:
+            return False
+        with self._lock:
+            angle = float(self._pos[self._axes.index(table.axis)])
+            if angle == self._table_angle:
+                return False
+            self._table_angle = angle
+            self._scene = build_scene(self._scenario, table_angle=angle)
+        return True
+
     def _move(self, target: np.ndarray, feed: float | None, rapid: bool) -> MoveResult:
         """Positioning with collision monitoring; caller holds the busy flag."""
         start = self._pos.copy()
@@ -472,14 +507,11 @@ class SimulatedMachine:
     # --- machine view --------------------------------------------------------------------
     def scene_geometry(self) -> dict:
         """The true scene for the machine view (JSON-ready, MCS)."""
-        from .physics import rpy_matrix
-
         sc = self._scenario
         out: dict = {"block": None, "circles": [], "rects": []}
         wp = sc.workpiece
         if wp is not None and wp.block is not None:
-            rot = rpy_matrix(wp.pose.rot)
-            trans = np.asarray(wp.pose.trans, dtype=float)
+            rot, trans = workpiece_pose(sc, self._table_angle)
 
             def place(x: float, y: float, z: float) -> list[float]:
                 return [float(v) for v in rot @ np.array([x, y, z]) + trans]

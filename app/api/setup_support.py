@@ -1,0 +1,39 @@
+"""Set-up support after measuring (spec/jog-measuring.md §6.2): the activation screen's data,
+NC Start (carry it out) and ``<<`` (leave without activating)."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter
+from pydantic import BaseModel, ConfigDict, Field
+
+from app.deps import ServicesDep
+from app.workflow import setup_support
+
+router = APIRouter(prefix="/measure", tags=["measure"])
+
+
+class CarryOutBody(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    activate: bool = Field(True, description="select the corrected WO in the channel")
+    realign: bool = Field(True, description="swivel the probe parallel to the new infeed axis")
+    retract: bool = Field(True, description="retract along the tool axis before swivelling")
+    position_rotary: bool = Field(True, description="turn the rotary axis to align the workpiece")
+
+
+@router.get("/{session_id}/setup-support")
+def setup_support_screen(session_id: str, services: ServicesDep) -> dict:
+    """The activation screen: results, corrected WO, toggle fields, texts."""
+    return setup_support.screen_model(services.workflow, services.machine, session_id)
+
+
+@router.post("/{session_id}/setup-support")
+def carry_out(session_id: str, services: ServicesDep, body: CarryOutBody | None = None) -> dict:
+    """NC Start on the activation screen."""
+    choices = setup_support.Choices(**(body or CarryOutBody()).model_dump())
+    return setup_support.carry_out(services.workflow, services.machine, session_id, choices, db=services.db)
+
+
+@router.delete("/{session_id}/setup-support")
+def leave(session_id: str, services: ServicesDep) -> dict:
+    """``<<``: leave without activating (the written correction stays)."""
+    return setup_support.leave(services.workflow, session_id)
