@@ -31,6 +31,16 @@ def probe_record_from(data: dict | None, tool: dict | None, length_to_tip: bool)
     )
 
 
+def probe_number_for(records: list[dict], spindle_tool: int | None, gud_probe_number: int) -> int:
+    """The active _WP record follows the tool in the spindle: the record calibrated with (bound
+    to) that T; else _JM_I[1] (_PRNUM: the last two digits are the probe number, spec §8.1)."""
+    if spindle_tool is not None:
+        for record in records:
+            if record.get("tool") == spindle_tool:
+                return int(record["number"])
+    return int(gud_probe_number) % 100 or 1
+
+
 class MeasuringEnv:
     """Implements ``app.workflow.service.WorkflowEnv`` with the app's services."""
 
@@ -50,7 +60,7 @@ class MeasuringEnv:
             offsets = {n: Frame.from_api(f) for n, f in unit.list_offsets().items()}
             names = unit.offset_names()
             tool = unit.get_tool(st.tool) if st.tool is not None else None
-            probe_no = int(gud.probe_number) % 100 or 1
+            probe_no = probe_number_for(unit.list_probes(), st.tool, int(gud.probe_number))
             probe_data = unit.get_probe(probe_no)
             tool_probe = unit.get_tool_probe(int(gud.tool_probe_number))
         basic = sorted((n for n in names if n.startswith("BASIC_") and n != "BASIC_REF"),

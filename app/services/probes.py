@@ -42,6 +42,10 @@ class ProbeData(BaseModel):
     calibration_feed: float | None = Field(None, gt=0)
     calibration_override: float | None = Field(None, ge=0, le=120)
     calibrated_at: str | None = None
+    tool: int | None = Field(None, ge=1, le=9999)               # T of the probe this record belongs to
+    cal_ring_diameter: float | None = Field(None, gt=0, le=1000)  # gauge of the radius calibration
+    cal_height: float | None = Field(None, ge=-10000, le=10000)   # surface of the length calibration
+    cal_wo: str | None = Field(None, max_length=12)              # WO the calibration was measured in
 
     @field_validator("trigger")
     @classmethod
@@ -63,6 +67,7 @@ class ToolProbeData(BaseModel):
     calibrated_diameter: bool = False
     calibration_tool: int | None = Field(None, ge=1)
     calibration_feed: float | None = Field(None, gt=0)
+    calibration_override: float | None = Field(None, ge=0, le=120)   # feed override when calibrated
     calibrated_at: str | None = None
 
     @field_validator("trigger")

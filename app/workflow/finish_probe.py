@@ -1,0 +1,113 @@
+"""Finishers of the workpiece probe calibration: ``probe.length`` and ``probe.radius``.
+
+Spec: spec/jog-measuring.md §5.2/§5.3, measuring-math §7.2/§7.3/§7.5; math in engine.calibration.
+The finisher writes the probe record ``_WP[k]`` (``app.services.probes.ProbeData``) and, for
+length calibration, the probe's tool length L1 (the machine gets it via refresh_tool_offset).
+Every record remembers how it was calibrated: measuring feed and feed override (the measuring
+tasks warn when the override differs, spec §5.1), time, gauge (ring diameter or surface
+height and the WO it refers to), plane, and the tool number of the probe it belongs to (the
+active record follows the tool in the spindle, app.services.measuring).
+"""
+
+from __future__ import annotations
+
+from datetime import UTC, datetime
+
+from app.workflow.service import MeasureSession, MeasuringContext
+from engine.calibration import evaluate_probe_task
+from engine.types import MeasuringError, ProbeRecord
+
+NO_PROBE_ALARM = 61309      # "Check probe type" (spec §10): no type-710 probe in the spindle
+
+
+def _probe_of(ctx: MeasuringContext) -> ProbeRecord:
+    if ctx.probe is None or ctx.tool is None:
+        raise MeasuringError(NO_PROBE_ALARM, "No workpiece probe (type 710) in the spindle: load the probe")
+    return ctx.probe
+
+
+def _record(ctx: MeasuringContext, probe: ProbeRecord, extra: dict) -> tuple[int, dict]:
+    """The stored record ``_WP[k]`` with the calibration results merged in (ProbeData keys)."""
+    n = int(ctx.extra.get("probe_number") or probe.number)
+    stored = dict(ctx.probe_data or {})
+    record = {
+        **stored,
+        "number": n,
+        "ball_diameter": float(probe.ball_diameter),
+        "effective_diameter": float(probe.effective_diameter),
+        "trigger": {k: float(v) for k, v in probe.trigger.items()},
+        "skew": [float(probe.skew[0]), float(probe.skew[1])],
+        "length_to_tip": bool(probe.length_to_tip),
+        "calibrated_radius": bool(probe.calibrated_radius),
+        "calibrated_length": bool(probe.calibrated_length),
+        "calibrated_plane": ctx.plane.name,
+        "calibration_feed": float(ctx.settings.get("measuring_feed", 300.0)),
+        "calibration_override": float(ctx.feed_override),
+        "calibrated_at": datetime.now(UTC).isoformat(timespec="seconds"),
+        "tool": int(ctx.tool["t"]) if ctx.tool else stored.get("tool"),
+        **extra,
+    }
+    from app.services.probes import ProbeData  # lazy: app.services imports the workflow
+
+    return n, ProbeData.model_validate(record).model_dump(mode="json")
+
+
+def surface_height(params: dict, infeed: str) -> float:
+    """The calibration surface on the infeed axis: validate_params gives ``{axis: value}``."""
+    value = params.get("setpoint", 0.0)
+    return float(value.get(infeed, 0.0) if isinstance(value, dict) else value)
+
+
+def finish_probe_radius(session: MeasureSession, ctx: MeasuringContext) -> tuple[dict, dict]:
+    probe = _probe_of(ctx)
+    point = session.slots[0].point
+    try:
+        new, values = evaluate_probe_task("probe.radius", session.params, point, probe, ctx.plane,
+                                          wcs2bcs=ctx.chain().wcs2bcs)
+    except ValueError as exc:
+        raise MeasuringError(61301, str(exc)) from exc
+    n, record = _record(ctx, new, {"cal_ring_diameter": float(session.params["diameter"]),
+                                   "cal_wo": ctx.active_offset})
+    values["probe"] = {**values["probe"], **_calibration_view(record)}
+    answer = {"result": values, "correction": None, "activated": False, "setup_support": None}
+    return answer, {"offset": None, "probe_update": (n, record)}
+
+
+def finish_probe_length(session: MeasureSession, ctx: MeasuringContext) -> tuple[dict, dict]:
+    probe = _probe_of(ctx)
+    point = session.slots[0].point
+    height = surface_height(session.params, ctx.plane.infeed)
+    try:
+        new, values = evaluate_probe_task("probe.length", {**session.params, "setpoint": height}, point,
+                                          probe, ctx.plane, length_old=float(ctx.tool_length))
+    except ValueError as exc:
+        raise MeasuringError(61301, str(exc)) from exc
+    # the NC measured with L1 + wear; the difference goes into the geometry L1 (DP3)
+    tool = dict(ctx.tool or {})
+    t = int(tool["t"])
+    before = {"length": float(tool.get("length", 0.0)),
+              "wear": {"length": float((tool.get("wear") or {}).get("length", 0.0))}}
+    length_new = before["length"] + values["difference"]
+    if length_new <= 0.0:
+        raise MeasuringError(61301, f"calibrated length L1 = {length_new:.4f} is not positive: "
+                                    "check the surface height")
+    values["length"] = length_new
+    n, record = _record(ctx, new, {"cal_height": height,
+                                   "cal_wo": ctx.active_offset})
+    values["probe"] = {**values["probe"], **_calibration_view(record)}
+    values["tool"] = {"t": t, "length": length_new}
+    correction = {"target": f"T{t}", "before": before,
+                  "after": {"length": length_new, "wear": before["wear"]}}
+    answer = {"result": values, "correction": correction, "activated": False, "setup_support": None}
+    tool_row = {k: v for k, v in tool.items() if k in ("t", "name", "type", "length", "radius", "wear")}
+    tool_row["length"] = length_new
+    return answer, {"offset": None, "probe_update": (n, record), "tool_update": (t, tool_row)}
+
+
+def _calibration_view(record: dict) -> dict:
+    keys = ("number", "tool", "calibrated_plane", "calibration_feed", "calibration_override",
+            "calibrated_at", "cal_ring_diameter", "cal_height", "cal_wo")
+    return {k: record.get(k) for k in keys}
+
+
+FINISHERS = {"probe.length": finish_probe_length, "probe.radius": finish_probe_radius}
