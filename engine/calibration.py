@@ -122,14 +122,18 @@ def calibrate_radius(point: RingCalibrationPoint, probe: ProbeRecord, plane: Pla
     skew_wcs = np.zeros(3)
     triggers: dict[str, float] = {}
     for axis in (plane.first, plane.second):
-        m180, _, _ = _pass_mid(pass180, axis)
-        m0, rec_plus, rec_minus = _pass_mid(pass0, axis)
+        m180, plus180, minus180 = _pass_mid(pass180, axis)
+        m0, plus0, minus0 = _pass_mid(pass0, axis)
         e_j = 0.5 * (m180 - m0)                                  # §7.3 e = (m180 − m0)/2
         mp_j = 0.5 * (m0 + m180)                                 # §7.3 MP = (m0 + m180)/2
         centre[axis] = mp_j
         skew_wcs[axis_index(axis)] = e_j
-        triggers[f"{axis}+"] = rec_plus + e_j - (mp_j + half)    # §7.2 t = rec + e − S
-        triggers[f"{axis}-"] = rec_minus + e_j - (mp_j - half)
+        # §7.2 t = rec + e − S; the 180° pass sees the skew turned, −e: both passes averaged
+        # (the skew cancels either way; two latches per direction halve the noise variance)
+        ball_plus = 0.5 * ((plus0 + e_j) + (plus180 - e_j))
+        ball_minus = 0.5 * ((minus0 + e_j) + (minus180 - e_j))
+        triggers[f"{axis}+"] = ball_plus - (mp_j + half)
+        triggers[f"{axis}-"] = ball_minus - (mp_j - half)
     for key, value in triggers.items():
         if (value < 0.0) != key.endswith("+") or value == 0.0:
             raise MeasuringError(61303, f"trigger value {key} = {value:.4f} has the wrong sign: "
@@ -173,8 +177,10 @@ def evaluate_probe_task(task: str, params: dict, point, probe: ProbeRecord, plan
             raise ValueError(f"probe.length needs an EdgePoint, got {type(point).__name__}")
         if length_old is None:
             raise ValueError("probe.length needs the probe's current L1 (length_old)")
-        record, numbers = calibrate_length_point(point, float(params.get("setpoint", 0.0)), probe,
-                                                 length_old, plane)
+        setpoint = params.get("setpoint", 0.0)
+        if isinstance(setpoint, dict):        # validate_params keys it by the infeed axis
+            setpoint = setpoint.get(plane.infeed, 0.0)
+        record, numbers = calibrate_length_point(point, float(setpoint), probe, length_old, plane)
     elif task == "probe.radius":
         if not isinstance(point, RingCalibrationPoint):
             raise ValueError(f"probe.radius needs a RingCalibrationPoint, got {type(point).__name__}")

@@ -259,6 +259,19 @@ def _edge_distance(task, params, points, plane, probe) -> TaskResult:
 
 # --- corners ----------------------------------------------------------------------------------
 
+def _normal_shift(plane: Plane, probe: ProbeRecord, touch: Touch, normal) -> float:
+    """Ball-centre-to-surface distance along the edge normal n̂ for an axis-parallel touch.
+
+    The overtravel δ = r − |t| (pre-travel + latency path) runs along the probing direction d̂,
+    so only δ·cosθ of it (θ = angle between d̂ and n̂) brings the centre nearer the edge:
+    shift = r − δ·cosθ (measuring-math §5.3 / §12.3; equals |t| for θ = 0).
+    """
+    rho = trigger_radius(probe, touch.direction, plane)
+    cos_theta = abs(float(_ao(plane, touch.direction) @ normal))
+    r_nominal = probe.ball_diameter / 2.0
+    return r_nominal - (r_nominal - rho) * cos_theta
+
+
 def _surface_line(plane: Plane, probe: ProbeRecord, touches: Sequence[Touch]) -> tuple[LineFit, list]:
     """Edge line: fit through the ball centres, shifted by ρ_dir along n̂ (n̂·d̂ > 0) (§5.3 [I])."""
     centres = [_ao(plane, t.ball_centre) for t in touches]
@@ -270,7 +283,7 @@ def _surface_line(plane: Plane, probe: ProbeRecord, touches: Sequence[Touch]) ->
     travel = np.sum([_ao(plane, t.direction) for t in touches], axis=0)
     if normal @ travel < 0.0:
         normal = -normal
-    shifted = [c + trigger_radius(probe, t.direction, plane) * normal     # §5.3 ρ_dir·n̂
+    shifted = [c + _normal_shift(plane, probe, t, normal) * normal     # §5.3 ρ_dir·n̂
                for c, t in zip(centres, touches, strict=True)]
     return fit_line(np.array(shifted)), shifted
 
@@ -300,7 +313,7 @@ def _corner(task, params, points, plane, probe) -> TaskResult:
         c3 = _ao(plane, touches[2].ball_centre)
         n2 = line1.direction if line1.direction @ _ao(plane, touches[2].direction) > 0 \
             else -line1.direction
-        q3 = c3 + trigger_radius(probe, touches[2].direction, plane) * n2      # §5.3 shift
+        q3 = c3 + _normal_shift(plane, probe, touches[2], n2) * n2             # §5.3 shift
         line2 = LineFit(point=q3, direction=perp)
         corner = intersect_lines(line1, line2)                                 # §12.3
         _check_outside(line1, q12[0], q12[1], corner, "P1 and P2")

@@ -42,19 +42,26 @@ def touch_aop(plane: Plane, c, d, s) -> Touch:
                  surface=plane.to_xyz(np.asarray(s, float)))
 
 
+BALL_RADIUS = PROBE.ball_diameter / 2.0
+
+
 def edge_touch_2d(p0, u, travel_axis: int, sign: float, w: float, radius: float):
-    """Ball (radius) travelling along plane axis ``travel_axis`` (0 = a, 1 = o) with ``sign``
-    at the other coordinate ``w`` onto the line p0 + λ·u: (ball centre, direction, contact)."""
+    """Ball travelling along plane axis ``travel_axis`` (0 = a, 1 = o) with ``sign`` at the
+    other coordinate ``w`` onto the line p0 + λ·u: (latched ball centre, direction, contact).
+
+    Physics as the simulator's (design.md §5): first contact at the ball radius from the line,
+    then the overtravel δ = ball radius − ``radius`` (the trigger radius) along the travel.
+    """
     d = np.zeros(2)
     d[travel_axis] = sign
     n_free = np.array([-u[1], u[0]])
     if n_free @ d > 0:
         n_free = -n_free                          # the ball stays on the side it comes from
     other = 1 - travel_axis
-    base = p0 + radius * n_free
+    base = p0 + BALL_RADIUS * n_free
     lam = (w - base[other]) / u[other]
-    centre = base + lam * u
-    return centre, d, centre - radius * n_free
+    first_contact = base + lam * u
+    return first_contact + (BALL_RADIUS - radius) * d, d, first_contact - BALL_RADIUS * n_free
 
 
 def lift(plane: Plane, v2, p: float) -> np.ndarray:

@@ -83,7 +83,9 @@ def test_11_1_A_align_edge():
 def test_12_A_any_corner_line_offset_rule():
     """§12-A: ball centres (ρ = 2.99, P1/P2 +Y, P3/P4 +X) -> K = (20, 30), φ = 2°.
 
-    The point-wise rule would be 0.0018 mm off in S1_y; the line-offset rule is exact.
+    The point-wise rule would be 0.0018 mm off in S1_y. The example puts the ball centres at ρ
+    along the normal; the engine models the overtravel along the travel (design.md §5), which
+    differs from the example by δ(1 − cos 2°) ≈ 6e-6 mm.
     """
     probe = ProbeRecord(ball_diameter=6.0, trigger={"X+": -2.99, "Y+": -2.99})
     pts = [EdgePoint(touch((50.0, 28.055801, 0.0), "Y+", -2.99)),
@@ -106,14 +108,15 @@ def test_12_A_right_angled_corner_with_p3():
     u1, u2 = np.array([np.cos(phi), np.sin(phi)]), np.array([-np.sin(phi), np.cos(phi)])
     k = np.array([20.0, 30.0])
 
-    def ball_on(u, n_free, coord_index, value):
-        base = k + 2.99 * n_free
+    def ball_on(u, n_free, coord_index, value, travel):
+        # first contact at the ball radius 3.0, then 0.01 overtravel along the travel (design §5)
+        base = k + 3.0 * n_free
         lam = (value - base[coord_index]) / u[coord_index]
-        return base + lam * u
+        return base + lam * u + 0.01 * travel
 
-    c1 = ball_on(u1, -u2, 0, 50.0)
-    c2 = ball_on(u1, -u2, 0, 150.0)
-    c3 = ball_on(u2, -u1, 1, 40.0)
+    c1 = ball_on(u1, -u2, 0, 50.0, np.array([0.0, 1.0]))
+    c2 = ball_on(u1, -u2, 0, 150.0, np.array([0.0, 1.0]))
+    c3 = ball_on(u2, -u1, 1, 40.0, np.array([1.0, 0.0]))
     pts = [EdgePoint(touch((*c1, 0.0), "Y+", -2.99)), EdgePoint(touch((*c2, 0.0), "Y+", -2.99)),
            EdgePoint(touch((*c3, 0.0), "X+", -2.99))]
     res = evaluate("corner.right", {"kind": "outside", "position": 1}, pts, G17, probe)
