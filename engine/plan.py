@@ -95,7 +95,7 @@ def _setpoint_axis(params: dict, axis: str) -> dict[str, float]:
         if extra:
             raise ParamError(f"setpoint.{extra[0]}", f"setpoint may only give the {axis} value")
         value = value.get(axis, 0.0)
-    return {axis: _number({f"setpoint.{axis}": value}, f"setpoint.{axis}", 0.0)}
+    return {axis: _number({f"setpoint.{axis}": value}, f"setpoint.{axis}", 0.0) or 0.0}   # empty = 0
 
 
 def _setpoint_point(params: dict, plane: Plane) -> dict[str, float]:
@@ -105,7 +105,7 @@ def _setpoint_point(params: dict, plane: Plane) -> dict[str, float]:
         raise ParamError("setpoint", "setpoint must be an object keyed by the plane's axis names")
     out = {}
     for axis in (plane.first, plane.second):
-        out[axis] = _number({f"setpoint.{axis}": value.get(axis, 0.0)}, f"setpoint.{axis}", 0.0)
+        out[axis] = _number({f"setpoint.{axis}": value.get(axis, 0.0)}, f"setpoint.{axis}", 0.0) or 0.0
     for key in value:
         if key not in out:
             raise ParamError(f"setpoint.{key}", f"setpoint axis {key!r} is not an axis of the plane {plane.name}")
@@ -123,7 +123,7 @@ def _angle_correction(params: dict, allowed_none: bool, default: str) -> str:
 
 
 def _setpoint_angle(params: dict) -> float:
-    value = _number(params, "setpoint_angle", 0.0)
+    value = _number(params, "setpoint_angle", 0.0) or 0.0     # empty field = 0 (spec §2.3)
     if not -360.0 < value < 360.0:      # spec §2.3 [I]: setpoint angle in (−360, 360)
         raise ParamError("setpoint_angle", f"setpoint_angle must lie in (-360, 360), got {value:g}")
     return value
@@ -176,7 +176,7 @@ def validate_params(task: str, params: dict, plane: Plane) -> dict:
         out["diameter"] = _positive(params, "diameter", required=spigot)  # hole: may be empty (§2.3)
         if spigot:
             out["infeed"] = _positive(params, "infeed", required=True)
-        out["probe_angle"] = _number(params, "probe_angle", 0.0)
+        out["probe_angle"] = _number(params, "probe_angle", 0.0) or 0.0
         if variant in ("2", "3", "4"):
             out["angle_correction"] = _angle_correction(params, variant != "2",
                                                         "rotation" if variant == "2" else "none")
@@ -194,7 +194,7 @@ def validate_params(task: str, params: dict, plane: Plane) -> dict:
     elif task == "toolprobe.calibrate":
         out["mode"] = _choice(params, "mode", ("length", "length_diameter"), "length")
     elif family == "tool":
-        value = _number(params, "offset_v", 0.0)
+        value = _number(params, "offset_v", 0.0) or 0.0
         if value < 0.0:
             raise ParamError("offset_v", f"offset_v must be >= 0, got {value:g}")
         out["offset_v"] = value

@@ -408,6 +408,11 @@ class MachineService:
                                            "wear": {"length": 0.0, "radius": 0.0}})
             if reset:
                 unit.set_state(STATE_TOOL, None)
+            if sc.tool_probe is not None:   # its disc diameter is commissioning data, like nominal tool data
+                n = 1 if reset else int(self._settings.get().tool_probe_number)
+                record = unit.get_tool_probe(n) or {}
+                if not record.get("disc_diameter"):
+                    unit.put_tool_probe(n, {**record, "disc_diameter": float(sc.tool_probe.disc_diameter)})
         if reset:
             self._settings.reset_to_defaults()
 

@@ -1,0 +1,198 @@
+"""Finishers of tool measuring in JOG: ``toolprobe.calibrate``, ``tool.length``, ``tool.diameter``.
+
+Spec: spec/jog-measuring.md §7.2/§7.3 (+ §8.3 E_MESS_MT_*), measuring-math §14; the math is
+engine.toolmeasure. The points come from engine.plan_tool (tool tip in MCS at the latch).
+
+- Calibration writes the tool-probe record ``_TP[n]`` (``app.services.probes.ToolProbeData``):
+  trigger values per travel direction (tool edge at switching, MCS), how it was calibrated
+  (tool, feed, override, time) and the E_MESS_MT_* data it was calibrated with.
+- Length / diameter write the active tool's offset (spec §7.3, _JM_B[0]): ``geometry`` ->
+  geometry := measured, the wear of that component := 0; ``wear`` -> wear := measured − geometry.
+  The API parameter ``compensation`` overrides the setting ``tool_offset_mode`` (_JM_B[0]).
+
+Latch delay (design.md §5 flying measurement, measuring-math §1.5 e_lat = v·t): calibration runs
+at E_MESS_MT_FM, rotating-spindle measuring at F = n·E_MESS_MIN_D (≈ 10 mm/min), so a signal
+delay t leaves (v_meas − v_cal)·t in the result (4 ms: 6 µm). [I] The two probing stages of a
+measurement touch the same point at different feeds; their latched positions give t, and the
+result is referred to feed 0 on both sides: value += (v_meas − v_cal)·t (v = feed·override).
+"""
+
+from __future__ import annotations
+
+from datetime import UTC, datetime
+
+import numpy as np
+
+from app.workflow.planning import active_tool, tool_probe_widths
+from app.workflow.service import MeasureSession, MeasuringContext
+from engine.plan_base import ToolPoint, ToolProbePoint
+from engine.planes import axis_index
+from engine.toolmeasure import calibrate_tool_probe_point, tool_offset_update, tool_point_value
+from engine.types import MeasuringError
+
+TOOL_KEYS = ("t", "name", "type", "length", "radius", "wear")
+MIN_FEED_SPREAD = 1.0           # mm/min between the stages needed to estimate the latch delay
+
+
+def _now() -> str:
+    return datetime.now(UTC).isoformat(timespec="seconds")
+
+
+def _point(session: MeasureSession, kind: type):
+    point = session.slots[0].point
+    if not isinstance(point, kind):
+        raise MeasuringError(61301, f"{session.task}: no measured point stored")
+    return point
+
+
+def _tool_probe_number(ctx: MeasuringContext) -> int:
+    return int(ctx.extra.get("tool_probe_number") or ctx.settings.get("tool_probe_number", 1))
+
+
+def _validated_tool_probe(record: dict) -> dict:
+    from app.services.probes import ToolProbeData  # lazy: app.services imports the workflow
+
+    return ToolProbeData.model_validate(record).model_dump(mode="json")
+
+
+def _validated_tool(row: dict) -> dict:
+    from pydantic import ValidationError
+
+    from app.services.tools import ToolData
+
+    try:
+        return ToolData.model_validate(row).model_dump()
+    except ValidationError as exc:
+        first = exc.errors()[0]
+        where = ".".join(str(p) for p in first["loc"])
+        raise MeasuringError(61303, f"Measured tool data out of range ({where}: {first['msg']}): "
+                                    "check the tool probe calibration and the tool") from None
+
+
+# --- tool probe calibration (spec §7.2, math §14.5) --------------------------------------------
+
+def finish_toolprobe_calibrate(session: MeasureSession, ctx: MeasuringContext) -> tuple[dict, dict]:
+    tool = active_tool(ctx)
+    point = _point(session, ToolProbePoint)
+    n = _tool_probe_number(ctx)
+    stored = dict(ctx.extra.get("tool_probe") or {})
+    old_trigger = {k: float(v) for k, v in (stored.get("trigger") or {}).items()}
+    trigger, values = calibrate_tool_probe_point(point, ctx.plane, old_trigger)
+    s = ctx.settings
+    diameter_mode = point.mode == "length_diameter"
+    a, o = ctx.plane.first, ctx.plane.second
+    measured_keys = {touch.key for touch in point.touches}
+    width = {axis: trigger[f"{axis}-"] - trigger[f"{axis}+"] for axis in (a, o)
+             if f"{axis}-" in measured_keys and f"{axis}+" in measured_keys}
+    disc = float(stored.get("disc_diameter") or 0.0)
+    if disc <= 0.0 and width:                  # not entered: the measured probe width (1st axis)
+        disc = float(width.get(a, next(iter(width.values()))))
+    feeds = [t.feed for t in point.touches if t.feed > 0.0]
+    record = {
+        **{k: v for k, v in stored.items() if k != "number"},
+        "number": n,
+        "trigger": trigger,
+        "disc_diameter": disc,
+        "axes": int(s.get("mt_ax", 133)),
+        "type": int(s.get("mt_type", 0)),
+        "dz": float(s.get("mt_dz", 2.0)),
+        "calibrated_length": True,
+        "calibrated_diameter": bool(stored.get("calibrated_diameter")) or diameter_mode,
+        "calibration_tool": int(tool["t"]),
+        "calibration_feed": float(feeds[-1]) if feeds else float(s.get("mt_fm", 100.0)),
+        "calibration_override": float(ctx.feed_override),
+        "calibrated_at": _now(),
+    }
+    record = _validated_tool_probe(record)
+    result = {"tool_probe": record, "mode": point.mode, "difference": values["difference"],
+              "center": values["center"], "width": width,
+              "calibration_tool": {"t": int(tool["t"]), "length": float(point.tool_length),
+                                   "radius": float(point.tool_radius)}}
+    answer = {"result": result,
+              "correction": {"target": f"TP{n}", "before": old_trigger or None, "after": record["trigger"]},
+              "activated": False, "setup_support": None}
+    return answer, {"offset": None, "tool_probe_update": (n, record)}
+
+
+# --- latch delay ----------------------------------------------------------------------------------
+
+def _direction(key: str) -> np.ndarray:
+    d = np.zeros(3)
+    d[axis_index(key[0])] = 1.0 if key[1] == "+" else -1.0
+    return d
+
+
+def latch_delay(raw: list[dict], point, override: float) -> float | None:
+    """Signal delay t [s] from the stages of the final probing (same point, different feeds):
+    s_i = S + v_i·t along the travel (least squares); None if the stages cannot tell."""
+    k = len(point.feeds)
+    if k < 2 or len(raw) < k:
+        return None
+    stages = raw[-k:]
+    if not all(r.get("triggered") and r.get("rec") is not None for r in stages):
+        return None
+    d = _direction(point.touch.key)
+    s = np.array([float(np.asarray(r["rec"], float) @ d) for r in stages])
+    v = np.array(point.feeds, float) * override / 100.0 / 60.0          # mm/s
+    if np.ptp(v) * 60.0 < MIN_FEED_SPREAD:
+        return None
+    vc = v - v.mean()
+    return max(0.0, float(vc @ (s - s.mean()) / (vc @ vc)))      # a delay is never negative
+
+
+def latch_correction(session: MeasureSession, point, record: dict, ctx: MeasuringContext) -> dict:
+    """value* = value + (v_meas − v_cal)·t (both latches referred to feed 0; module docstring)."""
+    override = float(ctx.feed_override)
+    t = latch_delay(session.slots[0].raw, point, override)
+    v_meas = float(point.feeds[-1]) * override / 100.0 / 60.0
+    cal_feed = float(record.get("calibration_feed") or ctx.settings.get("mt_fm", 100.0))
+    cal_override = record.get("calibration_override")
+    v_cal = cal_feed * float(override if cal_override is None else cal_override) / 100.0 / 60.0
+    correction = 0.0 if t is None else (v_meas - v_cal) * t
+    return {"delay_s": t, "feed": float(point.feeds[-1]), "calibration_feed": cal_feed,
+            "correction": float(correction)}
+
+
+# --- tool length / radius (spec §7.3, math §14.4) -----------------------------------------------
+
+def finish_tool_measure(session: MeasureSession, ctx: MeasuringContext) -> tuple[dict, dict]:
+    tool = active_tool(ctx)
+    point = _point(session, ToolPoint)
+    record = dict(ctx.extra.get("tool_probe") or {})
+    trigger = {k: float(v) for k, v in (record.get("trigger") or {}).items()}
+    name = "length" if point.kind == "length" else "radius"
+    latch = latch_correction(session, point, record, ctx)
+    measured = tool_point_value(point, trigger, ctx.plane) + latch["correction"]
+    if measured <= 0.0:
+        raise MeasuringError(61303, f"Measured {name} {measured:.4f} mm is not positive: check the tool "
+                                    "probe calibration and the start position")
+    mode = session.params.get("compensation") or ctx.settings.get("tool_offset_mode", "geometry")
+    wear = dict(tool.get("wear") or {})
+    update = tool_offset_update(measured, float(tool.get(name, 0.0)), float(wear.get(name, 0.0)), mode)
+    row = {k: v for k, v in tool.items() if k in TOOL_KEYS}
+    before = {"length": float(tool.get("length", 0.0)), "radius": float(tool.get("radius", 0.0)),
+              "wear": {"length": float(wear.get("length", 0.0)), "radius": float(wear.get("radius", 0.0))}}
+    row["wear"] = dict(before["wear"])
+    row[name] = update["geometry"]
+    row["wear"][name] = update["wear"]
+    row = _validated_tool(row)
+    t = int(row["t"])
+    after = {"length": row["length"], "radius": row["radius"], "wear": dict(row["wear"])}
+    dl, _dr = tool_probe_widths(ctx.settings, record)
+    result = {name: measured, "tool": {"t": t, **after}, "mode": mode, "delta": update["delta"],
+              "spindle": {"rotating": bool(point.rotating), "speed": float(point.speed),
+                          "feeds": [float(f) for f in point.feeds]},
+              "offset_v": float(point.offset_v), "lateral_offset": float(point.lateral_offset),
+              "probe_width_length": dl, "latch": latch}
+    if name == "radius":
+        result["diameter"] = 2.0 * measured
+    answer = {"result": result, "correction": {"target": f"T{t}", "before": before, "after": after},
+              "activated": False, "setup_support": None}
+    return answer, {"offset": None, "tool_update": (t, row)}
+
+
+FINISHERS = {
+    "toolprobe.calibrate": finish_toolprobe_calibrate,
+    "tool.length": finish_tool_measure,
+    "tool.diameter": finish_tool_measure,
+}
