@@ -187,10 +187,11 @@ class SimulatedMachine:
 
     # --- Reset / stop --------------------------------------------------------------------
     def reset(self) -> None:
-        """Abort any motion at its current position and clear the resettable alarms."""
+        """Abort any motion at its current position, stop the spindle, clear resettable alarms."""
         self._abort.set()
         self._wait_idle()
         with self._lock:
+            self._spindle_speed = 0.0          # NC Reset ends M3/M4 like a real control
             self._alarms = [a for a in self._alarms if not a.resettable]
 
     def stop(self) -> None:

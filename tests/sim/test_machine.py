@@ -328,3 +328,11 @@ def test_bench_one_probing_move(capsys):
     with capsys.disabled():
         print(f"\n[bench] one sim move at time_scale 0: {per_move * 1e3:.2f} ms")
     assert per_move < 0.05
+
+
+def test_reset_stops_the_spindle():
+    m = SimulatedMachine(scenario())
+    m.spindle_rotate(800.0)
+    assert m.status().spindle_speed == 800.0
+    m.reset()
+    assert m.status().spindle_speed == 0.0
