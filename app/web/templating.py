@@ -26,7 +26,7 @@ HORIZONTAL_SOFTKEYS: list[tuple[str, str, str] | None] = [
     ("tools", "Tool list", "/tools"),
     ("machine_view", "Machine view", "/machine-view"),
     ("settings", "Settings", "/settings"),
-    None,
+    ("log", "Log", "/log"),
     ("jog", "JOG", "/jog"),
 ]
 

@@ -1,0 +1,120 @@
+"""Measuring input screens and the log screen over HTTP: full page vs htmx blocks, field errors,
+NC Start through the screen, Back, export. Expected values come from tests/hmi_testdata.py."""
+
+from __future__ import annotations
+
+import csv
+import io
+
+import pytest
+from hmi_testdata import BLOCK_TOP_Z, PROBE_LENGTH, TEST_SCENARIO
+
+from app.web.task_screens import PAGES
+
+HTMX = {"HX-Request": "true"}
+HOLE = TEST_SCENARIO["workpiece"]["features"][1]
+PART_T = TEST_SCENARIO["workpiece"]["pose"]["trans"]
+HOLE_MCS = (PART_T[0] + HOLE["center"][0], PART_T[1] + HOLE["center"][1])
+
+
+@pytest.mark.parametrize("task", sorted(PAGES))
+def test_every_input_screen_full_page_and_htmx_block(client, task):
+    url = PAGES[task].url
+    full = client.get(url)
+    assert full.status_code == 200 and full.text.startswith("<!doctype html>")
+    assert f'data-task="{task}"' in full.text and 'id="task-form"' in full.text
+    assert "data-ncstart" in full.text and "/static/measure.css" in full.text
+    block = client.get(url, headers=HTMX)
+    assert block.status_code == 200 and "<html" not in block.text
+    assert block.text.lstrip().startswith('<div id="screen"')
+    assert 'id="vsoftkeys" class="vsoftkeys" hx-swap-oob="true"' in block.text
+
+
+def test_multi_point_screen_has_p_keys_but_no_calculate_until_all_stored(client):
+    text = client.get("/measure/workpiece/corner/any", headers=HTMX).text
+    for n in (1, 2, 3, 4):
+        assert f"P{n} stored" in text
+    assert "Calculate" not in text
+    single = client.get("/measure/workpiece/edge/set", headers=HTMX).text
+    assert "P1 stored" not in single
+
+
+def test_target_is_preset_to_the_active_wo(client):
+    client.post("/api/machine/activate", json={"offset": "G55"})
+    text = client.get("/measure/workpiece/edge/set").text
+    assert '<option value="G55" selected>' in text
+    client.post("/api/machine/activate", json={"offset": "G500"})
+    assert '<option value="measure_only" selected>' in client.get("/measure/workpiece/edge/set").text
+
+
+def test_field_check_shows_the_error_next_to_the_field(client):
+    answer = client.post("/measure/task/hole.1/check/diameter", data={"diameter": "-3"}, headers=HTMX)
+    assert answer.status_code == 200
+    assert answer.text.startswith('<span id="err-diameter" class="field-error"')
+    assert "Approx. diameter must be &gt; 0" in answer.text
+    ok = client.post("/measure/task/hole.1/check/diameter", data={"diameter": "20"}, headers=HTMX)
+    assert '<span id="err-diameter" class="field-error" role="alert"></span>' in ok.text
+
+
+def test_nc_start_with_bad_input_keeps_the_text_and_changes_nothing(client):
+    before = client.get("/api/offsets/G54").json()
+    position = client.get("/api/machine").json()["mcs"]
+    answer = client.post("/measure/task/spigot.1/start", data={"target": "G54", "diameter": "abc", "infeed": "5"},
+                         headers=HTMX)
+    assert answer.status_code == 200
+    assert 'value="abc"' in answer.text and "must be a number" in answer.text
+    assert client.get("/api/offsets/G54").json() == before
+    assert client.get("/api/machine").json()["mcs"] == position
+    assert client.get("/api/log").json() == []
+
+
+def _ball_to(client, x, y, z):
+    for target in ({"Z": 0.0}, {"X": x, "Y": y}, {"Z": z + PROBE_LENGTH}):
+        assert client.post("/api/machine/goto", json={**target, "coords": "MCS"}).status_code == 200
+
+
+def test_one_hole_through_the_screen_writes_g54_and_the_log(client):
+    client.post("/api/machine/tool", json={"tool": 9})
+    client.post("/api/machine/activate", json={"offset": "G54"})
+    _ball_to(client, HOLE_MCS[0] + 1.0, HOLE_MCS[1] - 2.0, BLOCK_TOP_Z - 10.0)
+    answer = client.post("/measure/task/hole.1/start", headers=HTMX, data={
+        "target": "G54", "diameter": "20", "probe_angle": "0", "setpoint.X": "0", "setpoint.Y": "0"})
+    assert 'id="task-result"' in answer.text
+    assert f'data-result="Diameter">{HOLE["diameter"]:.3f}<' in answer.text
+    g54 = client.get("/api/offsets/G54").json()["trans"]
+    assert g54["X"] == pytest.approx(HOLE_MCS[0], abs=1e-6) and g54["Y"] == pytest.approx(HOLE_MCS[1], abs=1e-6)
+    log_page = client.get("/log").text
+    assert "hole.1" in log_page and f"trans.X 0.000→{HOLE_MCS[0]:.3f}" in log_page
+    rows = list(csv.reader(io.StringIO(client.get("/log/export.csv").text)))
+    assert rows[0][:4] == ["id", "time", "task", "target"] and rows[1][2:4] == ["hole.1", "G54"]
+    exported = client.get("/log/export.json")
+    assert exported.headers["content-type"].startswith("application/json")
+    assert exported.json()[0]["result"]["diameter"] == pytest.approx(HOLE["diameter"], abs=1e-9)
+    detail = client.get(f"/log/{exported.json()[0]['id']}", headers=HTMX)
+    assert detail.status_code == 200 and 'class="log-detail"' in detail.text
+
+
+def test_alarm_shows_on_the_screen_and_nothing_is_stored(client):
+    client.post("/api/machine/tool", json={"tool": 9})
+    _ball_to(client, 100.0, 100.0, BLOCK_TOP_Z - 10.0)     # in front of the block: -Y probes into nothing
+    answer = client.post("/measure/task/edge.align/start", headers=HTMX,
+                         data={"axis": "Y", "direction": "-", "reference_axis": "X"})
+    assert 'class="task-alarm"' in answer.text and "61301" in answer.text
+    assert all(not p["stored"] for p in client.get("/api/measure/current").json()["points"])
+
+
+def test_back_deletes_the_session_and_shows_the_parent_menu(client):
+    client.post("/api/measure", json={"task": "corner.right", "params": {}})
+    answer = client.post("/measure/task/corner.right/leave", headers=HTMX)
+    assert answer.headers["HX-Push-Url"] == "/measure/workpiece/corner"
+    assert "Right-angled corner" in answer.text and "Any corner" in answer.text
+    assert client.get("/api/measure/current").json() is None
+
+
+def test_log_screen_empty_and_unknown_entry(client):
+    assert "No measurements yet." in client.get("/log").text
+    assert client.get("/log/999").status_code == 404
+
+
+def test_horizontal_softkey_log(client):
+    assert 'href="/log"' in client.get("/jog").text
