@@ -88,6 +88,10 @@ class Frame:
         object.__setattr__(self, "rot", _vec3(self.rot, "rot"))
         rotary = tuple(sorted((str(k), float(v)) for k, v in dict(self.rotary).items()))
         object.__setattr__(self, "rotary", rotary)
+        # the matrix is needed on every point mapping: computed once (frozen), read-only
+        rotation = matrix_from_rpy(self.rot)
+        rotation.flags.writeable = False
+        object.__setattr__(self, "_rotation", rotation)
 
     # --- construction -------------------------------------------------------------------
     @classmethod
@@ -113,7 +117,7 @@ class Frame:
 
     @property
     def rotation(self) -> np.ndarray:
-        return matrix_from_rpy(self.rot)
+        return self._rotation
 
     def rotary_offset(self, axis: str) -> float:
         return dict(self.rotary).get(axis, 0.0)

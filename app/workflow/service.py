@@ -124,16 +124,55 @@ class WorkflowService:
             normalised = self._plan.validate_params(task, dict(params or {}), ctx.plane)
         except ValueError as exc:
             raise WorkflowError(400, "invalid_param", str(exc), getattr(exc, "field", None)) from exc
+        self._check_rotary_axis(normalised)
         chosen = target or ctx.active_offset
         if chosen == "G500":
             chosen = MEASURE_ONLY if task.split(".")[0] not in ("probe", "tool", "toolprobe") else chosen
         self._check_target(task, chosen, ctx)
-        with self._lock:
+        # never wait for a running NC Start (it holds the lock for the whole measurement)
+        if not self._lock.acquire(blocking=False):
+            raise WorkflowError(409, "busy", "a measurement is running; press Reset first")
+        try:
             if self._session is not None and self._session.running:
                 raise WorkflowError(409, "busy", "a measurement is running; press Reset first")
             self._session = MeasureSession.create(task, normalised, chosen, ctx.active_offset,
                                                   self._task_points[task])
             return self._session
+        finally:
+            self._lock.release()
+
+    def _check_rotary_axis(self, params: dict) -> None:
+        """A rotary-axis angle correction names a configured rotary axis (spec §2.3 [I])."""
+        axis = params.get("angle_correction")
+        if axis in (None, "rotation", "none"):
+            return
+        if axis not in tuple(getattr(self._env.machine, "axes", ())):
+            raise WorkflowError(400, "invalid_param",
+                                f"angle_correction: {axis} is not a rotary axis of this machine",
+                                "angle_correction")
+
+    # params that only enter the calculation may change while points are stored (spec §3.1 [I])
+    EDITABLE_WHILE_STORED = frozenset({"setpoint", "setpoint_angle", "angle_correction", "set_p1", "target"})
+
+    def update_params(self, session_id: str, params: dict, target: str | None = None) -> MeasureSession:
+        """Change setpoints/target of an open session until Calculate; probing params stay locked."""
+        session = self.get(session_id)
+        if session.running:
+            raise WorkflowError(409, "busy", "a measurement is running")
+        ctx = self._env.measuring_context()
+        try:
+            normalised = self._plan.validate_params(session.task, dict(params or {}), ctx.plane)
+        except ValueError as exc:
+            raise WorkflowError(400, "invalid_param", str(exc), getattr(exc, "field", None)) from exc
+        if any(s.stored for s in session.slots):
+            for key in set(normalised) | set(session.params):
+                if key not in self.EDITABLE_WHILE_STORED and normalised.get(key) != session.params.get(key):
+                    raise WorkflowError(409, "locked", f"{key} is locked while a point is stored", key)
+        self._check_rotary_axis(normalised)
+        chosen = target or session.target
+        self._check_target(session.task, chosen, ctx)
+        session.params, session.target = normalised, chosen
+        return session
 
     def _check_target(self, task: str, target: str, ctx: MeasuringContext) -> None:
         if task.split(".")[0] in ("probe", "tool", "toolprobe"):
@@ -155,7 +194,8 @@ class WorkflowService:
         try:
             session.invalidate(n)
         except KeyError:
-            raise WorkflowError(404, "no_point", f"point P{n} does not exist for {session.task}") from None
+            raise WorkflowError(404, "no_point", f"point P{n} does not exist for {session.task}",
+                                    "point") from None
         return session
 
     # --- NC Start -----------------------------------------------------------------------
@@ -176,7 +216,8 @@ class WorkflowService:
             try:
                 slot = session.slot(n)
             except KeyError:
-                raise WorkflowError(404, "no_point", f"point P{n} does not exist for {session.task}") from None
+                raise WorkflowError(404, "no_point", f"point P{n} does not exist for {session.task}",
+                                    "point") from None
             alarms = [a for a in self._env.machine.status().alarms]
             if alarms:
                 raise WorkflowError(409, "alarm", f"{alarms[-1].code} {alarms[-1].text}: press Reset first")
