@@ -122,18 +122,16 @@ def calibrate_radius(point: RingCalibrationPoint, probe: ProbeRecord, plane: Pla
     skew_wcs = np.zeros(3)
     triggers: dict[str, float] = {}
     for axis in (plane.first, plane.second):
-        m180, plus180, minus180 = _pass_mid(pass180, axis)
+        m180, _, _ = _pass_mid(pass180, axis)
         m0, plus0, minus0 = _pass_mid(pass0, axis)
         e_j = 0.5 * (m180 - m0)                                  # §7.3 e = (m180 − m0)/2
         mp_j = 0.5 * (m0 + m180)                                 # §7.3 MP = (m0 + m180)/2
         centre[axis] = mp_j
         skew_wcs[axis_index(axis)] = e_j
-        # §7.2 t = rec + e − S; the 180° pass sees the skew turned, −e: both passes averaged
-        # (the skew cancels either way; two latches per direction halve the noise variance)
-        ball_plus = 0.5 * ((plus0 + e_j) + (plus180 - e_j))
-        ball_minus = 0.5 * ((minus0 + e_j) + (minus180 - e_j))
-        triggers[f"{axis}+"] = ball_plus - (mp_j + half)
-        triggers[f"{axis}-"] = ball_minus - (mp_j - half)
+        # §7.2 t = rec + e − S, from the 0° pass only: its chords run through the centre (the
+        # search ran at 0°); the 180° pass's chords are 2e off-centre, which biases their ends
+        triggers[f"{axis}+"] = plus0 + e_j - (mp_j + half)
+        triggers[f"{axis}-"] = minus0 + e_j - (mp_j - half)
     for key, value in triggers.items():
         if (value < 0.0) != key.endswith("+") or value == 0.0:
             raise MeasuringError(61303, f"trigger value {key} = {value:.4f} has the wrong sign: "
