@@ -24,6 +24,7 @@ from app.services import (
     ToolService,
 )
 from app.services.measuring import MeasuringEnv
+from app.services.plc import PlcSimulator
 from app.services.scenarios import read_scenario
 from app.web import web_router
 from app.workflow.registry import build_workflow
@@ -43,6 +44,7 @@ def build_services(settings: Settings, scenario: Scenario) -> Services:
         probes=ProbeService(db), tool_probes=ToolProbeService(db), log=LogService(db),
     )
     services.workflow = build_workflow(MeasuringEnv(db, machine, gud))
+    services.plc = PlcSimulator(lambda: services.workflow)
     return services
 
 

@@ -2,12 +2,10 @@
 
 from fastapi import APIRouter
 
-from . import data, machine, measure
+from . import data, machine, measure, plc, setup_support
 
 api_router = APIRouter(prefix="/api")
-api_router.include_router(machine.router)
-api_router.include_router(data.router)
-api_router.include_router(measure.router)
-api_router.include_router(__import__("app.api.setup_support", fromlist=["router"]).router)
+for module in (machine, data, measure, setup_support, plc):
+    api_router.include_router(module.router)
 
 __all__ = ["api_router"]

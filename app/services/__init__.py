@@ -14,6 +14,7 @@ from db import Database
 from .log import LogService
 from .machine_service import MachineService
 from .offsets import OffsetService
+from .plc import PlcSimulator
 from .probes import ProbeService, ToolProbeService
 from .settings import SettingsService
 from .tools import ToolService
@@ -30,6 +31,7 @@ class Services:
     tool_probes: ToolProbeService
     log: LogService
     workflow: WorkflowService | None = None
+    plc: PlcSimulator | None = None
 
 
 __all__ = ["LogService", "MachineService", "OffsetService", "ProbeService", "Services", "ToolProbeService", "SettingsService", "ToolService"]

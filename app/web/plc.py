@@ -1,0 +1,57 @@
+"""PLC test page ``/plc``: DB19.DBB43 as LEDs with toggles for bits 0..3 (spec §3.2) and the
+readiness checklist (spec §1.6 [I]). Both parts refresh by htmx polling."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+from fastapi import APIRouter, Form, Request
+
+from app.deps import ServicesDep
+from app.errors import HmiError
+from app.services.plc import MEANINGS
+from app.services.readiness import ReadinessService
+
+from .templating import render_block, render_screen
+
+router = APIRouter()
+
+
+def _byte_ctx(services, message: str = "", level: str = "info") -> dict:
+    return {"plc": services.plc.snapshot(), "meanings": MEANINGS, "plc_message": message, "plc_level": level}
+
+
+def _readiness_ctx(services) -> dict:
+    return {"readiness": ReadinessService(services).report()}
+
+
+@router.get("/plc")
+def plc_screen(request: Request, services: ServicesDep):
+    return render_screen(request, "plc.html", {"screen": "plc", **_byte_ctx(services), **_readiness_ctx(services)})
+
+
+@router.get("/plc/db19")
+def plc_byte(request: Request, services: ServicesDep):
+    return render_block(request, "plc.html", "plc_byte", _byte_ctx(services))
+
+
+@router.post("/plc/db19/bit")
+def plc_toggle(request: Request, services: ServicesDep, bit: Annotated[str, Form()],
+               value: Annotated[str, Form()]):
+    try:
+        number = int(bit) if bit.strip().lstrip("-").isdigit() else bit
+        services.plc.write(number, value == "1")
+    except HmiError as exc:
+        return render_block(request, "plc.html", "plc_byte", _byte_ctx(services, exc.message, "error"))
+    return render_block(request, "plc.html", "plc_byte", _byte_ctx(services))
+
+
+@router.post("/plc/db19/mode")
+def plc_mode(request: Request, services: ServicesDep, auto_release: Annotated[str | None, Form()] = None):
+    services.plc.set_auto_release(auto_release in ("on", "true", "1"))
+    return render_block(request, "plc.html", "plc_byte", _byte_ctx(services))
+
+
+@router.get("/plc/readiness")
+def readiness_block(request: Request, services: ServicesDep):
+    return render_block(request, "plc.html", "readiness", _readiness_ctx(services))
