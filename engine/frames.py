@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -240,8 +241,9 @@ class FrameChain:
         """Parent of the settable frame -> BCS (everything outside G54..)."""
         return compose_chain([self.setframe, *self.basic])
 
-    @property
+    @cached_property
     def wcs2bcs(self) -> Frame:
+        """Composed once per chain value (the chain is immutable)."""
         return self.below_settable.compose(self.settable)
 
     def p_in_bcs(self, p_in_wcs) -> np.ndarray:

@@ -4,6 +4,8 @@ Owns the one ``Machine`` (the simulator, later a real controller). WCS positions
 the tool tip: ``tip = axes - L * infeed_unit`` with L the NC's offset length (tool length +
 wear) along the infeed axis of the measuring plane, and ``tip_mcs = wcs2bcs(p_wcs)`` (BCS = MCS).
 The active settable offset and the tool in the spindle are persisted in the db state.
+With a swivel head turned out of +Z the length goes along the machine's actual tool axis
+(``status().tool_axis``, TRAORI-like), so that WCS tip positions stay right (``length_axis``).
 """
 
 from __future__ import annotations
@@ -109,7 +111,36 @@ class MachineService:
             "alarms": alarms,
             "busy": bool(st.busy),
             "program_state": program_state,
+            "tool_axis": [float(v) for v in getattr(st, "tool_axis", (0.0, 0.0, 1.0))],
+            "swivel": self.has_swivel(),
         }
+
+    # --- swivel head (CYCLE800-like re-alignment, spec §6.2) --------------------------------
+    def has_swivel(self) -> bool:
+        return bool(getattr(self._machine, "has_swivel", lambda: False)())
+
+    def length_axis(self, status=None) -> np.ndarray:
+        """The direction of the tool length L in MCS: the plane's infeed axis while the tool axis
+        is +Z (3-axis convention, any plane), the machine's actual tool axis when swivelled."""
+        st = status if status is not None else self._machine.status()
+        axis = np.asarray(getattr(st, "tool_axis", (0.0, 0.0, 1.0)), dtype=float)
+        if float(np.linalg.norm(axis - np.array([0.0, 0.0, 1.0]))) < 1e-12:
+            return self.plane().infeed_unit
+        return axis
+
+    def retract_tool_axis(self, distance: float | None = None) -> dict:
+        """Retract up along the tool axis (to the limits by default) before a swivel (spec §11 Q9)."""
+        if distance is not None:
+            distance = _finite(distance, "distance")
+        return self._run(lambda: self._machine.retract_tool_axis(distance))
+
+    def swivel_to_wcs(self) -> dict:
+        """Swivel the head so that the tool axis is parallel to the active WCS's infeed axis."""
+        if not self.has_swivel():
+            raise InvalidInput("this machine has no swivel kinematics", field="realign")
+        rotation = self._chain.wcs2bcs.as_matrix()[:3, :3]
+        infeed = np.asarray(self.plane().infeed_unit, dtype=float)
+        return self._run(lambda: self._machine.swivel_to_wcs(rotation, infeed))
 
     # --- coordinates ----------------------------------------------------------------------
     def wcs_from_mcs(self, mcs: Mapping[str, float], tool_length: float | None = None) -> dict[str, float]:
@@ -117,7 +148,7 @@ class MachineService:
             tool_length = self._machine.status().tool_length
         chain = self._chain
         axes_xyz = np.array([float(mcs[a]) for a in GEOMETRY_AXES])
-        tip_mcs = axes_xyz - tool_length * self.plane().infeed_unit
+        tip_mcs = axes_xyz - tool_length * self.length_axis()
         p_wcs = chain.wcs2bcs.parent2child(tip_mcs)
         out = {a: float(v) for a, v in zip(GEOMETRY_AXES, p_wcs, strict=True)}
         for axis in self.rotary_axes:
@@ -131,7 +162,7 @@ class MachineService:
             tool_length = self._machine.status().tool_length
         chain = self._chain
         p_wcs = np.array([float(wcs[a]) for a in GEOMETRY_AXES])
-        axes_xyz = chain.wcs2bcs.child2parent(p_wcs) + tool_length * self.plane().infeed_unit
+        axes_xyz = chain.wcs2bcs.child2parent(p_wcs) + tool_length * self.length_axis()
         out = {a: float(v) for a, v in zip(GEOMETRY_AXES, axes_xyz, strict=True)}
         for axis in self.rotary_axes:
             if axis in wcs:
@@ -350,11 +381,14 @@ class MachineService:
         name = name.upper()
         with self._lock:
             chain = self.build_chain(name)
-            self._machine.activate_frame(ActiveFrame(name=name, wcs2bcs=chain.wcs2bcs.as_matrix(),
-                                                     rotary_offsets=dict(chain.wcs2bcs.rotary)))
+            wcs2bcs = chain.wcs2bcs
+            self._machine.activate_frame(ActiveFrame(name=name, wcs2bcs=wcs2bcs.as_matrix(),
+                                                     rotary_offsets=dict(wcs2bcs.rotary)))
+            changed = name != self._active_offset
             self._chain, self._active_offset = chain, name
-            with self._db.unit() as unit:
-                unit.set_state(STATE_ACTIVE_OFFSET, name)
+            if changed:          # re-activating the same WO (after a correction) needs no write
+                with self._db.unit() as unit:
+                    unit.set_state(STATE_ACTIVE_OFFSET, name)
         return self.status()
 
     def refresh_frame(self) -> None:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Protocol
 
 import numpy as np
@@ -50,6 +51,10 @@ class MeasuringContext:
     extra: dict = field(default_factory=dict)
 
     def chain(self) -> FrameChain:
+        return self._chain
+
+    @cached_property
+    def _chain(self) -> FrameChain:
         outside = [self.offsets[n] for n in self.chain_names]
         settable = self.offsets.get(self.active_offset, Frame.identity())
         return FrameChain(setframe=outside[0] if outside else Frame.identity(),
