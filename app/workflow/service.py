@@ -229,6 +229,9 @@ class WorkflowService:
             session.running = True
             session.last_alarm = None
             ctx = self._env.measuring_context()
+            if session.task.split(".")[0] not in ("tool", "toolprobe") and ctx.probe is None:
+                raise WorkflowError(409, "alarm", "61309 Check probe type: the tool in the spindle is "
+                                                  "not a 3D probe (type 710); change to the probe first")
             session.warnings = self._warnings(session, ctx)
             if self._refuse_override(ctx):
                 raise WorkflowError(409, "override_mismatch", session.warnings[-1])

@@ -251,3 +251,15 @@ def test_openapi_has_the_measure_calls_with_examples(client):
     examples = create.get("examples") or []
     assert examples and all("task" in e for e in examples)
     assert {e["task"] for e in examples} >= {"hole.1", "corner.right", "edge.set"}
+
+
+def test_nc_start_with_a_cutter_in_the_spindle_is_refused_with_61309(client):
+    """Spec §10 [I]: probe not the active tool -> 61309, no motion, nothing stored."""
+    assert client.post("/api/machine/tool", json={"tool": 1}).status_code == 200
+    before = client.get("/api/machine").json()["mcs"]
+    session = client.post("/api/measure", json={"task": "edge.set",
+                                                "params": {"axis": "X", "direction": "+"}}).json()
+    answer = client.post(f"/api/measure/{session['id']}/start")
+    assert answer.status_code == 409 and answer.json()["error"]["message"].startswith("61309")
+    assert client.get("/api/machine").json()["mcs"] == before
+    assert client.get(f"/api/measure/{session['id']}").json()["points"][0]["stored"] is False
