@@ -30,10 +30,55 @@ def eccentricity_at(eccentricity_xy, spindle_angle_deg: float) -> np.ndarray:
     return np.array([ex * math.cos(phi) - ey * math.sin(phi), ex * math.sin(phi) + ey * math.cos(phi), 0.0])
 
 
-def ball_centre(axes_xyz, true_length: float, eccentricity_xy, spindle_angle_deg: float) -> np.ndarray:
-    """True ball centre = A + e(φ) − L·ẑ (design.md §4 scenario, A = tool reference point)."""
-    return np.asarray(axes_xyz, dtype=float) + eccentricity_at(eccentricity_xy, spindle_angle_deg) \
-        - true_length * Z_UNIT
+def ball_centre(axes_xyz, true_length: float, eccentricity_xy, spindle_angle_deg: float,
+                head=None) -> np.ndarray:
+    """True ball centre = A + R_head·(e(φ) − L·ẑ) (design.md §4 scenario, A = tool reference point,
+    R_head = identity without a swivel head, scenario.SwivelHead)."""
+    offset = eccentricity_at(eccentricity_xy, spindle_angle_deg) - true_length * Z_UNIT
+    if head is not None:
+        offset = np.asarray(head, dtype=float) @ offset
+    return np.asarray(axes_xyz, dtype=float) + offset
+
+
+def _axis_rotation(axis: str, deg: float) -> np.ndarray:
+    rot = {"A": (deg, 0.0, 0.0), "B": (0.0, deg, 0.0), "C": (0.0, 0.0, deg)}[axis]
+    return rpy_matrix(rot)
+
+
+def head_rotation(head_axes, angles_deg) -> np.ndarray:
+    """R_head = R_second(θ_second)·R_first(θ_first) (scenario.SwivelHead; axes alphabetical)."""
+    (first, second), (t1, t2) = head_axes, angles_deg
+    return _axis_rotation(second, float(t2)) @ _axis_rotation(first, float(t1))
+
+
+def head_angles_for(head_axes, n, current=(0.0, 0.0)) -> list[tuple[float, float]]:
+    """All (θ_first, θ_second) in degrees with R_head·ẑ = n (unit), before limit/wrap choice.
+
+    A/B: n = (cosA·sinB, −sinA, cosA·cosB); A/C: n = (sinA·sinC, −sinA·cosC, cosA);
+    B/C: n = (sinB·cosC, sinB·sinC, cosB). Near the pole (inner angle 0) the outer angle
+    is free: it stays where it is.
+    """
+    nx, ny, nz = (float(v) for v in np.asarray(n, dtype=float) / np.linalg.norm(n))
+    out = []
+    if tuple(head_axes) == ("A", "B"):
+        a = -math.asin(max(-1.0, min(1.0, ny)))
+        for a_i in (a, math.pi - a):
+            ca = math.cos(a_i)
+            if abs(ca) < 1e-12:
+                out.append((math.degrees(a_i), float(current[1])))
+            else:
+                out.append((math.degrees(a_i), math.degrees(math.atan2(nx / ca, nz / ca))))
+        return out
+    inner = math.acos(max(-1.0, min(1.0, nz)))
+    for t in (inner, -inner):
+        s = math.sin(t)
+        if abs(s) < 1e-9:
+            out.append((math.degrees(t), float(current[1])))
+        elif tuple(head_axes) == ("A", "C"):
+            out.append((math.degrees(t), math.degrees(math.atan2(nx / s, -ny / s))))
+        else:                                            # ("B", "C")
+            out.append((math.degrees(t), math.degrees(math.atan2(ny / s, nx / s))))
+    return out
 
 
 def pretravel_along(direction, table: dict[str, float]) -> float:

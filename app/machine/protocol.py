@@ -66,6 +66,7 @@ class MachineStatus:
     alarms: tuple[Alarm, ...]
     mode: str = "JOG"
     plane: str = "G17"
+    tool_axis: tuple[float, float, float] = (0.0, 0.0, 1.0)   # MCS unit vector tip -> spindle (swivel head)
 
 
 @dataclass(frozen=True)

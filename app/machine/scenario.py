@@ -48,6 +48,33 @@ class RotaryTable(_Model):
     center: Vec2 = (0.0, 0.0)
 
 
+class SwivelHead(_Model):
+    """A swivel head (CYCLE800-like re-alignment, spec §6.2): two rotary axes turn the tool.
+
+    Model (one, kept simple): the head pivots about the tool reference point (spindle nose,
+    the MCS X/Y/Z axis position). ``axes`` names the two head axes in alphabetical order
+    (first, second) = ("A", "B"), ("A", "C") or ("B", "C"); the second is the outer axis:
+    R_head = R_second(θ_second)·R_first(θ_first), e.g. A/B: Ry(B)·Rx(A) (the RPY order of
+    design.md §3), B/C fork head: Rz(C)·Ry(B). Both angles 0 = tool axis +Z (3-axis machine).
+
+    - tool axis in MCS = R_head·ẑ
+    - true ball centre = A + R_head·(e(φ) − L·ẑ)  (eccentricity and length turn with the head)
+    - pre-travel is a property of the probe: p(R_headᵀ·d) in the probe's own axes
+    - limits: the head axes' ``rotary_axes`` limits; a swivel is checked at samples of the
+      path (end pose included): the ball (or a cutter's end) must stay out of every solid.
+    """
+
+    type: Literal["swivel_head"] = "swivel_head"
+    axes: tuple[Literal["A", "B", "C"], Literal["A", "B", "C"]] = ("A", "B")
+
+    @field_validator("axes")
+    @classmethod
+    def _pair(cls, value: tuple[str, str]) -> tuple[str, str]:
+        if value[0] == value[1]:
+            raise ValueError("kinematics.axes: two different rotary axes")
+        return tuple(sorted(value))
+
+
 class MachineConfig(_Model):
     """Axis limits (MCS of the tool reference point), feeds and the braking model (§1.3)."""
 
@@ -60,6 +87,7 @@ class MachineConfig(_Model):
     kv: Positive = 1.0                 # position loop gain Kv, (m/min)/mm
     time_scale: NonNegative = 1.0      # 1 = real time, 0 = no waiting
     rotary_table: RotaryTable | None = None   # the part turns with this rotary axis (vertical table)
+    kinematics: SwivelHead | None = None      # swivel head (None: 3-axis tool axis +Z, no re-alignment)
 
     @field_validator("limits")
     @classmethod
@@ -246,6 +274,13 @@ class Scenario(_Model):
         table = self.machine.rotary_table
         if table is not None and table.axis not in self.rotary_axes:
             raise ValueError(f"machine.rotary_table.axis {table.axis!r} must be one of rotary_axes")
+        head = self.machine.kinematics
+        if head is not None:
+            for axis in head.axes:
+                if axis not in self.rotary_axes:
+                    raise ValueError(f"machine.kinematics.axes: {axis!r} must be one of rotary_axes")
+                if table is not None and table.axis == axis:
+                    raise ValueError(f"machine.kinematics.axes: {axis!r} is the rotary table's axis")
         numbers = [tool.t for tool in self.tools]
         if len(set(numbers)) != len(numbers):
             raise ValueError("tools: tool numbers must be unique")

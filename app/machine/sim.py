@@ -24,6 +24,15 @@ Decisions (where the spec leaves room):
 - Rotary axes are positions with limits; the axis named in ``machine.rotary_table`` turns the
   workpiece (not the gauges) about the vertical table axis (scene.workpiece_pose); the part is
   re-placed when a positioning of that axis ends (see ``_move_and_turn``).
+- Swivel head (scenario ``machine.kinematics``, model in scenario.SwivelHead): the head axes
+  are rotary axes of the machine; the ball centre is A + R_head·(e(φ) − L·ẑ) and the tool axis
+  R_head·ẑ. A motion that turns the head is checked at ``SWIVEL_SAMPLES`` poses along the path
+  (end pose included; X/Y/Z interpolated with the angles): any contact is a collision (61302)
+  and the motion is refused before it starts (the probe does not measure while swivelling).
+  ``swivel_to_wcs`` is CYCLE800-like: it solves the head angles for tool axis ∥ the WCS infeed
+  axis (the solution in the limits with the smallest axis motion; the twist about the tool axis
+  is not aligned). ``retract_tool_axis`` moves up along the tool axis (to the limits by default).
+  The tool probe's Minkowski sum assumes a vertical cutter (tool measuring with the head at 0).
 - Cutters: a flat-end cylinder, stationary or rotating alike (the full cylinder of radius R;
   the eccentricity of the ball probe is not smeared by rotation either). The tool probe
   contact is exact (Minkowski sum of two vertical cylinders); a cutter touching the
@@ -41,7 +50,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .physics import Z_UNIT, ball_centre, braking_distance, latency_path, pretravel_along
+from .physics import (
+    Z_UNIT,
+    ball_centre,
+    braking_distance,
+    head_angles_for,
+    head_rotation,
+    latency_path,
+    pretravel_along,
+)
 from .protocol import (
     ALARM_LIMIT,
     ALARM_PROBE_BROKEN,
@@ -61,6 +78,7 @@ from .scene import Body, Scene, build_scene, tool_probe_cylinder, workpiece_pose
 ALARM_NO_TOOL = 61343         # "no tool for the given tool identifier" (spec/jog-measuring.md §10)
 TICK_S = 0.01                 # motion update period at time_scale > 0
 WAIT_IDLE_S = 2.0             # how long reset()/stop() wait for a motion to end
+SWIVEL_SAMPLES = 16           # poses checked along a motion that turns the swivel head
 _XYZ = slice(0, 3)
 
 
@@ -129,7 +147,8 @@ class SimulatedMachine:
         with self._lock:
             mcs = {a: float(v) for a, v in zip(self._axes, self._pos, strict=True)}
             tool_length = self._offset_length if self._tool is not None else 0.0
-            tip_in_mcs = self._pos[_XYZ] - tool_length * Z_UNIT
+            axis = self._tool_axis_at(self._pos)
+            tip_in_mcs = self._pos[_XYZ] - tool_length * axis
             bcs2wcs = np.linalg.inv(np.asarray(self._frame.wcs2bcs, dtype=float))
             p_in_wcs = bcs2wcs @ np.append(tip_in_mcs, 1.0)
             wcs = {a: float(p_in_wcs[i]) for i, a in enumerate(GEOMETRY_AXES)}
@@ -139,7 +158,8 @@ class SimulatedMachine:
                 mcs=mcs, wcs=wcs, active_offset=self._frame.name, tool=self._tool,
                 tool_length=float(tool_length), feed_override=self._override,
                 spindle_angle=self._spindle_angle, spindle_speed=self._spindle_speed,
-                busy=self._busy, alarms=tuple(self._alarms))
+                busy=self._busy, alarms=tuple(self._alarms),
+                tool_axis=(float(axis[0]), float(axis[1]), float(axis[2])))
 
     # --- settings without motion ---------------------------------------------------------
     def change_tool(self, tool: int | None, offset_length: float) -> None:
@@ -303,13 +323,18 @@ class SimulatedMachine:
         Simplification: the path is checked with the part where it stood at the start of the
         move; a table turn that ends with the probe inside the part is a collision (61302).
         """
+        if self._head_turns(target):
+            alarm = self._swivel_collision(self._pos.copy(), target)
+            if alarm is not None:
+                return MoveResult(self._as_dict(self._pos), False, alarm)
         result = self._move(target, feed, rapid)
         if not self._sync_table():
             return result
         if self._probe_in_spindle():
             probe = self._scenario.probe
             with self._lock:
-                centre = ball_centre(self._pos[_XYZ], probe.length, probe.eccentricity, self._spindle_angle)
+                centre = ball_centre(self._pos[_XYZ], probe.length, probe.eccentricity, self._spindle_angle,
+                                     self._head(self._pos))
             if self._scene.sdf(centre) < probe.ball_diameter / 2.0:
                 alarm = self._raise_alarm(Alarm(ALARM_PROBE_COLLISION, "Probe collision: the rotary table "
                                                 "turned the workpiece into the probe"))
@@ -392,19 +417,22 @@ class SimulatedMachine:
         if tool is None:
             return None
         axes_xyz = start[_XYZ]
+        head = self._head(start)
         if tool == scenario.probe.t:
             probe = scenario.probe
-            centre = ball_centre(axes_xyz, probe.length, probe.eccentricity, angle)
+            centre = ball_centre(axes_xyz, probe.length, probe.eccentricity, angle, head)
             radius = probe.ball_diameter / 2.0
             s_contact = self._scene.first_contact(centre, d, length, radius)
             if s_contact is None:
                 return None
             # already deflected and pressing deeper: the probe signal is on at once
             deflected = s_contact == 0.0 and self._scene.sdf(centre) <= radius
-            s_switch = s_contact if deflected else s_contact + pretravel_along(d, probe.pretravel)
+            d_probe = d if head is None else head.T @ d          # pre-travel in the probe's own axes
+            s_switch = s_contact if deflected else s_contact + pretravel_along(d_probe, probe.pretravel)
             return _Event("switch", s_contact, s_switch, "Probe collision")
         cutter = scenario.tool(tool)
-        tip = axes_xyz - cutter.length * Z_UNIT
+        tool_axis = self._tool_axis_at(start)
+        tip = axes_xyz - cutter.length * tool_axis
         events = []
         tp = scenario.tool_probe
         if tp is not None:
@@ -415,7 +443,7 @@ class SimulatedMachine:
                 s_switch = s_contact if deflected else s_contact + tp.pretravel
                 events.append(_Event("switch", s_contact, s_switch, "Probe collision (tool probe)"))
         obstacles = self._scene.subset({"part", "ring_gauge"})
-        s_crash = obstacles.first_contact(tip + cutter.radius * Z_UNIT, d, length, cutter.radius)
+        s_crash = obstacles.first_contact(tip + cutter.radius * tool_axis, d, length, cutter.radius)
         if s_crash is not None:
             events.append(_Event("crash", s_crash, s_crash, f"Probe collision: T{tool} hit the workpiece"))
         if not events:
@@ -505,6 +533,116 @@ class SimulatedMachine:
     def _as_dict(self, position: np.ndarray) -> dict[str, float]:
         return {a: float(v) for a, v in zip(self._axes, position, strict=True)}
 
+    # --- swivel head (scenario.SwivelHead) -----------------------------------------------
+    def has_swivel(self) -> bool:
+        head = self._scenario.machine.kinematics
+        return head is not None and all(a in self._axes for a in head.axes)
+
+    def _head(self, position: np.ndarray) -> np.ndarray | None:
+        """R_head at the axis ``position`` (None without a swivel head)."""
+        if not self.has_swivel():
+            return None
+        head_axes = self._scenario.machine.kinematics.axes
+        return head_rotation(head_axes, [position[self._axes.index(a)] for a in head_axes])
+
+    def _tool_axis_at(self, position: np.ndarray) -> np.ndarray:
+        head = self._head(position)
+        return Z_UNIT.copy() if head is None else head @ Z_UNIT
+
+    def _head_turns(self, target: np.ndarray) -> bool:
+        if not self.has_swivel():
+            return False
+        index = [self._axes.index(a) for a in self._scenario.machine.kinematics.axes]
+        return any(target[i] != self._pos[i] for i in index)
+
+    def _swivel_collision(self, start: np.ndarray, target: np.ndarray) -> Alarm | None:
+        """Sample the swivel path (end pose included): the ball/cutter end must stay clear."""
+        self._check_limits(target)
+        with self._lock:
+            tool, angle = self._tool, self._spindle_angle
+        if tool is None:
+            return None
+        sc = self._scenario
+        for k in range(1, SWIVEL_SAMPLES + 1):
+            pose = start + (target - start) * (k / SWIVEL_SAMPLES)
+            head = self._head(pose)
+            if tool == sc.probe.t:
+                centre = ball_centre(pose[_XYZ], sc.probe.length, sc.probe.eccentricity, angle, head)
+                hit = self._scene.sdf(centre) < sc.probe.ball_diameter / 2.0
+            else:
+                cutter = sc.tool(tool)
+                axis = head @ Z_UNIT
+                end = pose[_XYZ] - (cutter.length - cutter.radius) * axis
+                hit = self._scene.subset({"part", "ring_gauge"}).sdf(end) < cutter.radius
+            if hit:
+                return self._raise_alarm(Alarm(ALARM_PROBE_COLLISION, "Probe collision: the swivel "
+                                               "would turn the tool into the workpiece"))
+        return None
+
+    def swivel_to(self, angles: dict[str, float]) -> MoveResult:
+        """Turn the head axes to ``angles`` (deg), collision-checked at samples, rapid."""
+        if not self.has_swivel():
+            raise ValueError("this machine has no swivel head")
+        head_axes = self._scenario.machine.kinematics.axes
+        unknown = set(angles) - set(head_axes)
+        if unknown:
+            raise ValueError(f"not a head axis: {sorted(unknown)}; the head has {list(head_axes)}")
+        return self.goto(dict(angles), None)
+
+    def head_angles_for(self, tool_axis) -> dict[str, float]:
+        """CYCLE800-like: the head angles within the limits that put the tool axis ∥ ``tool_axis``."""
+        if not self.has_swivel():
+            raise ValueError("this machine has no swivel head")
+        head_axes = self._scenario.machine.kinematics.axes
+        with self._lock:
+            current = [float(self._pos[self._axes.index(a)]) for a in head_axes]
+        best = None
+        for cand in head_angles_for(head_axes, tool_axis, current):
+            shifted = []
+            for axis, value, now in zip(head_axes, cand, current, strict=True):
+                lo, hi = self._limits[axis]
+                value = value + 360.0 * round((now - value) / 360.0)   # nearest turn to the current angle
+                while value > hi + 1e-9:
+                    value -= 360.0
+                while value < lo - 1e-9:
+                    value += 360.0
+                shifted.append(value if lo - 1e-9 <= value <= hi + 1e-9 else None)
+            if None in shifted:
+                continue
+            cost = max(abs(v - now) for v, now in zip(shifted, current, strict=True))
+            if best is None or cost < best[0] - 1e-9:
+                best = (cost, shifted)
+        if best is None:
+            alarm = self._raise_alarm(Alarm(ALARM_LIMIT, "Swivel: the tool axis cannot be reached within the "
+                                            "limits of the head axes"))
+            raise MachineAlarm(alarm)
+        return {a: float(v) for a, v in zip(head_axes, best[1], strict=True)}
+
+    def swivel_to_wcs(self, wcs2bcs_rotation, infeed=(0.0, 0.0, 1.0)) -> MoveResult:
+        """CYCLE800-like re-alignment: tool axis ∥ the WCS infeed axis R·infeed (MCS)."""
+        rotation = np.asarray(wcs2bcs_rotation, dtype=float)
+        if rotation.shape == (4, 4):
+            rotation = rotation[:3, :3]
+        n = rotation @ np.asarray(infeed, dtype=float)
+        return self.swivel_to(self.head_angles_for(n / np.linalg.norm(n)))
+
+    def retract_tool_axis(self, distance: float | None = None) -> MoveResult:
+        """Up along the tool axis by ``distance`` (default: as far as the X/Y/Z limits allow)."""
+        with self._lock:
+            axis = self._tool_axis_at(self._pos)
+            xyz = self._pos[_XYZ].copy()
+        s_max = math.inf
+        for i, name in enumerate(GEOMETRY_AXES):
+            lo, hi = self._limits[name]
+            if axis[i] > 1e-12:
+                s_max = min(s_max, (hi - xyz[i]) / axis[i])
+            elif axis[i] < -1e-12:
+                s_max = min(s_max, (lo - xyz[i]) / axis[i])
+        s = s_max if distance is None else _finite(distance, "distance")
+        s = max(0.0, min(s, s_max)) if distance is None else s
+        target = xyz + s * axis
+        return self.goto({a: float(v) for a, v in zip(GEOMETRY_AXES, target, strict=True)}, None)
+
     # --- machine view --------------------------------------------------------------------
     def scene_geometry(self) -> dict:
         """The true scene for the machine view (JSON-ready, MCS)."""
@@ -546,16 +684,18 @@ class SimulatedMachine:
         with self._lock:
             axes_xyz = self._pos[_XYZ].copy()
             tool, angle = self._tool, self._spindle_angle
+            head, tool_axis = self._head(self._pos), self._tool_axis_at(self._pos)
         if tool is not None and tool == sc.probe.t:
-            tip = ball_centre(axes_xyz, sc.probe.length, sc.probe.eccentricity, angle)
+            tip = ball_centre(axes_xyz, sc.probe.length, sc.probe.eccentricity, angle, head)
             probe = {"tip": tip, "diameter": sc.probe.ball_diameter, "is_probe": True, "tool_radius": 0.0}
         elif tool is not None:
             cutter = sc.tool(tool)
-            probe = {"tip": axes_xyz - cutter.length * Z_UNIT, "diameter": 2 * cutter.radius,
+            probe = {"tip": axes_xyz - cutter.length * tool_axis, "diameter": 2 * cutter.radius,
                      "is_probe": False, "tool_radius": cutter.radius}
         else:
             probe = {"tip": axes_xyz, "diameter": 0.0, "is_probe": False, "tool_radius": 0.0}
         probe["tip"] = [float(v) for v in probe["tip"]]
+        probe["axis"] = [float(v) for v in tool_axis]
         out["probe"] = probe
         return out
 

@@ -68,6 +68,9 @@ TOOL_MENU = Menu("Measure tool", "tool", (
     Leaf("Calibrate probe", "calibrate", "toolprobe.calibrate"),
 ))
 
+# the guided "tilted workpiece set-up" (app/web/tilted_setup.py): an extra softkey of the menu
+TILTED_SETUP_KEY = {"label": "Tilted set-up >", "href": "/measure/workpiece/tilted-setup"}
+
 # task id -> handler(request) rendering its input screen (filled in by the measuring workflow)
 INPUT_SCREENS: dict[str, Callable[[Request], object]] = {}
 
@@ -87,10 +90,14 @@ def _find(menu: Menu, slug: str):
     return next((item for item in menu.items if item.slug == slug), None)
 
 
-def _menu_screen(request: Request, menu: Menu, path: list[str], base: str, back: tuple[str, str]):
+def _menu_screen(request: Request, menu: Menu, path: list[str], base: str, back: tuple[str, str],
+                 extra: dict | None = None):
+    keys = softkeys(menu, base, back)
+    if extra is not None:                 # an extra softkey in the first free slot (before Back)
+        keys[len(menu.items)] = extra
     return render_screen(request, "measure_menu.html", {
         "screen": "measure_tool" if base.startswith("/measure/tool") else "measure_workpiece",
-        "menu": menu, "path": path, "vkeys": softkeys(menu, base, back)})
+        "menu": menu, "path": path, "vkeys": keys})
 
 
 def _leaf_screen(request: Request, leaf: Leaf, path: list[str], back: tuple[str, str]):
@@ -106,7 +113,7 @@ def _leaf_screen(request: Request, leaf: Leaf, path: list[str], back: tuple[str,
 @router.get("/measure/workpiece")
 def workpiece_menu(request: Request):
     return _menu_screen(request, WORKPIECE_MENU, [WORKPIECE_MENU.label], "/measure/workpiece",
-                        ("Back", "/jog"))
+                        ("Back", "/jog"), extra=TILTED_SETUP_KEY)
 
 
 @router.get("/measure/workpiece/{group}")

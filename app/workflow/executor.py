@@ -27,6 +27,14 @@ class StepExecutor:
     tool_length: float          # the NC's offset length L1 of the active tool
     tool_axis_mcs: np.ndarray   # unit vector from tool tip to spindle (G17: +Z)
 
+    def __post_init__(self) -> None:
+        # TRAORI-like: a swivelled head's actual tool axis (status) replaces the plane's infeed unit
+        axis = getattr(self.machine.status(), "tool_axis", None)
+        if axis is not None:
+            axis = np.asarray(axis, dtype=float)
+            if axis.shape == (3,) and float(np.linalg.norm(axis - np.array([0.0, 0.0, 1.0]))) >= 1e-12:
+                self.tool_axis_mcs = axis
+
     # --- conversions (names carry the direction) ----------------------------------------
     def axes_mcs(self) -> np.ndarray:
         mcs = self.machine.status().mcs

@@ -11,6 +11,10 @@ NC Start (``carry_out``):
   machine without swivel kinematics nothing moves; the screen says so and measuring continues
   with the probe as it is (a ball probe measures correctly obliquely in the tilted WCS).
 - retract first (spec §11 Q9): only before a swivel, up along the tool axis to the top limit.
+  The manual's toggle field 3 says "空运行" (dry run / traverse); the spec's function is kept.
+- with a swivel head (scenario ``machine.kinematics``), NC Start activates first, then retracts
+  and swivels the head so that the tool axis is ∥ the infeed axis of the (new) active WCS; the
+  WCS follows the kinematics (MachineService.length_axis), measuring goes on in the tilted WCS.
 - position rotary axis (spec §2.5.2, §11 Q8): turn the axis by the correction's ``rotary_move``
   from where it stood while measuring, so that the edge lies at the setpoint angle.
 
@@ -23,6 +27,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from app.errors import AlarmError
 from app.workflow.service import WorkflowError, WorkflowService
 
 TEXT_INACTIVE = "You are compensating in an inactive WO!"
@@ -32,6 +37,9 @@ TEXT_NC_START = "Press NC Start to activate!"
 TEXT_NO_SWIVEL = ("Re-alignment of the probe is not possible on this machine (no swivel "
                   "kinematics): measuring continues with the probe as it is")
 TEXT_ACTIVATED = "{wo} activated: it is the WO of the next measurement"
+TEXT_REALIGNED = "Probe re-aligned: tool axis parallel to {axis} of {wo} (head {angles})"
+HELP_RETRACT = ("Retract along the tool axis to the limit before swivelling (manual toggle field 3: "
+                "\u7a7a\u8fd0\u884c, dry run / traverse-free motion)")
 STATE_CHAIN_WO = "jm_i6"          # _JM_I[6]: WO of the next measurement (chain measuring, §6.1)
 AXES = ("X", "Y", "Z")
 
@@ -74,7 +82,7 @@ def toggles(support: dict, swivel: bool) -> list[dict]:
         out.append({"name": "realign", "label": "Re-align probe", "value": swivel,
                     "text": TEXT_REALIGN, "enabled": swivel})
         out.append({"name": "retract", "label": "Retract before swivel", "value": swivel,
-                    "text": "", "enabled": swivel})
+                    "text": "", "enabled": swivel, "help": HELP_RETRACT})
     for reason in support.get("reasons", []):
         if reason["code"] == "rotary":
             out.append({"name": "position_rotary", "label": reason.get("toggle", "Position rotary axis"),
@@ -158,12 +166,21 @@ def carry_out(workflow: WorkflowService, machine, session_id: str, choices: Choi
 
     if "realign" in codes and choices.realign:
         if swivel:
-            if choices.retract:
-                machine.retract_tool_axis()
-                actions.append("retract")
-            machine.swivel_to_wcs()
+            try:
+                if choices.retract:
+                    machine.retract_tool_axis()
+                    actions.append("retract")
+                    moved = True
+                status = machine.swivel_to_wcs()
+            except AlarmError as exc:
+                raise WorkflowError(409, "alarm", f"{exc}: the probe was not re-aligned (press Reset; "
+                                    "retract or move clear, then NC Start again)") from None
             actions.append("realign")
             moved = True
+            head = machine.scenario.machine.kinematics.axes
+            angles = ", ".join(f"{a}={status['mcs'][a]:.4f} deg" for a in head)
+            messages.append(TEXT_REALIGNED.format(axis=machine.plane().infeed, wo=machine.active_offset,
+                                                  angles=angles))
         else:
             messages.append(TEXT_NO_SWIVEL)
 

@@ -1,0 +1,165 @@
+"""Guided "tilted workpiece set-up" (spec/jog-measuring.md §6.1 chain measuring, §6.2, §6.3).
+
+A step list that walks the operator through the chain that ends in a full 6-DOF zero offset:
+
+1. Orient plane (measured under G500, corrected into the target WO, e.g. G54)
+2. Activate the target WO (+ re-align the probe with a swivel head) on the set-up support screen
+3. Right-angled corner (or Align edge) in the tilted plane, measuring WO = target
+4. Set edge Z (infeed axis) in the tilted plane
+-> done: the target WO holds translation and rotation (shown).
+
+Each step opens the existing input screen; from step 2 on, the WO the previous step produced is
+the proposal ``_JM_I[6]`` (db state ``jm_i6``, written by the set-up support) and is activated
+before the input screen opens, so that its "Zero offset" field is preset to it. Step 1 has no
+predecessor: it activates G500 (the measuring WO of spec §6.2 example 2) and the operator selects
+the target WO in the orient-plane screen (the input screens take no preset from a URL).
+
+Which steps are done comes from the measurement log (entries after the guided set-up was
+started, by task, target and measuring WO) and the state (active WO, ``jm_i6``).
+"""
+
+from __future__ import annotations
+
+from fastapi import APIRouter, Form, Request
+from fastapi.responses import RedirectResponse
+
+from app.workflow import setup_support as support
+
+from .templating import render_screen
+
+router = APIRouter()
+URL = "/measure/workpiece/tilted-setup"
+STATE = "tilted_setup"            # {"target": "G54", "since": last log id at the start}
+G500 = "G500"
+
+
+def _state(db) -> dict:
+    with db.unit(readonly=True) as unit:
+        return dict(unit.get_state(STATE, None) or {})
+
+
+def _log_since(db, since: int) -> list[dict]:
+    with db.unit(readonly=True) as unit:
+        entries = unit.list_log(limit=200)
+    return [e for e in reversed(entries) if e["id"] > since and e.get("status") == "ok"]
+
+
+def _measuring_wo(entry: dict) -> str | None:
+    return (entry.get("params") or {}).get("_measuring_wo")
+
+
+def steps_model(services) -> dict:
+    """The step list with done flags, the open URLs and the resulting WO."""
+    state = _state(services.db)
+    target = state.get("target")
+    machine = services.machine
+    plane = machine.plane()
+    chain_wo = support.chain_wo(services.db)
+    entries = _log_since(services.db, int(state.get("since", 0))) if target else []
+
+    def find(pred, after: int = 0) -> dict | None:
+        return next((e for e in entries if e["id"] > after and pred(e)), None)
+
+    plane_entry = find(lambda e: e["task"] == "plane.align" and e.get("target") == target)
+    s1 = plane_entry is not None
+    s2 = s1 and chain_wo == target and machine.active_offset == target
+    aligned = None
+    if s2 and machine.has_swivel():
+        status = machine.status()
+        chain = machine.chain.wcs2bcs
+        infeed = chain.dir_child2parent(plane.infeed_unit)
+        aligned = abs(float(sum(a * b for a, b in zip(status["tool_axis"], infeed, strict=True))) - 1.0) < 1e-9
+    after_plane = plane_entry["id"] if plane_entry else 0
+    corner = find(lambda e: e["task"] in ("corner.right", "edge.align") and e.get("target") == target
+                  and _measuring_wo(e) == target, after_plane) if s2 else None
+    edge = find(lambda e: e["task"] == "edge.set" and (e.get("params") or {}).get("axis") == plane.infeed
+                and e.get("target") == target and _measuring_wo(e) == target,
+                corner["id"] if corner else 0) if corner else None
+    done = [s1, s2, corner is not None, edge is not None]
+    steps = [
+        {"n": 1, "label": "Orient plane", "detail": f"measure the top face under G500, Zero offset = {target}",
+         "task": "plane.align"},
+        {"n": 2, "label": "Activate" + (" + re-align probe" if machine.has_swivel() else ""),
+         "detail": "set-up support: NC Start activates the WO" + (
+             " and swivels the probe perpendicular to the new plane" if machine.has_swivel() else
+             " (no swivel on this machine: the probe stays as it is)"), "task": "setup-support"},
+        {"n": 3, "label": "Right-angled corner (or Align edge) in the tilted plane",
+         "detail": f"measuring WO = {target}", "task": "corner.right"},
+        {"n": 4, "label": f"Set edge {plane.infeed}", "detail": f"measuring WO = {target}", "task": "edge.set"},
+    ]
+    current = next((i + 1 for i, d in enumerate(done) if not d), None)
+    for step, is_done in zip(steps, done, strict=True):
+        step["done"] = is_done
+        step["current"] = step["n"] == current
+        step["open"] = f"{URL}/open/{step['n']}"
+    offset = None
+    if target:
+        with services.db.unit(readonly=True) as unit:
+            offset = unit.list_offsets().get(target)
+    return {"target": target, "steps": steps, "complete": all(done) and target is not None,
+            "current": current, "chain_wo": chain_wo, "active": machine.active_offset,
+            "aligned": aligned, "swivel": machine.has_swivel(), "offset": offset,
+            "targets": [n for n in services.offsets.names() if n.startswith("G5")]}
+
+
+def _render(request: Request, notice: str = ""):
+    services = request.app.state.services
+    model = steps_model(services)
+    keys: list = [None] * 7 + [{"label": "Back", "href": "/measure/workpiece"}]
+    return render_screen(request, "tilted_setup.html", {
+        "screen": "measure_workpiece", "m": model, "notice": notice, "vkeys": keys,
+        "message": notice or _dialog(model)})
+
+
+def _dialog(model: dict) -> str:
+    if not model["target"]:
+        return "Select the zero offset to set up and press Start"
+    if model["complete"]:
+        return f"Set-up complete: {model['target']} holds the full 6-DOF zero offset"
+    return f"Next: step {model['current']}"
+
+
+@router.get(URL)
+def screen(request: Request):
+    return _render(request)
+
+
+@router.post(URL + "/start")
+def start(request: Request, target: str = Form("G54")):
+    """Start (or restart) the guided set-up for ``target``; the chain proposal ``_JM_I[6]`` is reset."""
+    services = request.app.state.services
+    if target not in services.offsets.names() or not target.startswith("G5"):
+        return _render(request, notice=f"{target!r} is not a settable zero offset")
+    with services.db.unit() as unit:
+        entries = unit.list_log(limit=1)
+        unit.set_state(STATE, {"target": target, "since": entries[0]["id"] if entries else 0})
+        unit.set_state(support.STATE_CHAIN_WO, None)
+    return RedirectResponse(URL, status_code=303)
+
+
+@router.post(URL + "/open/{n}")
+def open_step(request: Request, n: int):
+    """Open the input screen of step ``n`` with its measuring WO active (preset of the target)."""
+    services = request.app.state.services
+    model = steps_model(services)
+    if not model["target"]:
+        return _render(request, notice="Start the guided set-up first (select the zero offset)")
+    machine = services.machine
+    if n == 1:
+        machine.activate(G500)
+        return RedirectResponse("/measure/workpiece/plane", status_code=303)
+    if n == 2:
+        session = services.workflow.session
+        last = (session.last or {}) if session is not None else {}
+        if session is None or session.task != "plane.align" or not last.get("setup_support"):
+            return _render(request, notice="Measure step 1 (Orient plane) first: its set-up support "
+                                           "screen activates the WO")
+        return RedirectResponse(f"/measure/setup-support/{session.id}", status_code=303)
+    if n in (3, 4, 5):
+        proposal = model["chain_wo"] or model["target"]
+        if machine.active_offset != proposal:
+            machine.activate(proposal)
+        href = {3: "/measure/workpiece/corner/right", 4: "/measure/workpiece/edge/set",
+                5: "/measure/workpiece/edge/align"}[n]
+        return RedirectResponse(href, status_code=303)
+    return _render(request, notice=f"no step {n}")

@@ -1,0 +1,177 @@
+"""End to end: set-up support WITH a swivel head (spec §6.2 example 2) and the guided
+"tilted workpiece set-up" screen (chain measuring, spec §6.1) in Chromium.
+
+Measurements run through the API (the operator's probe positions come from the truth and its own
+head model, tests/flows/test_chain_swivel.SwivelOperator); the screens are driven in the browser.
+Truth: the scenario pose (the plane's normal, the part's position).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from playwright.sync_api import expect
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "flows"))
+from test_chain_swivel import TOP_POINTS, SwivelOperator, swivel  # noqa: E402
+from test_chain_truth import CHAIN_SCENARIO, pose_errors, rpy  # noqa: E402
+
+pytestmark = pytest.mark.e2e
+SWIVEL = swivel(CHAIN_SCENARIO, ("A", "B"))
+
+
+@pytest.fixture(scope="module")
+def server(tmp_path_factory):
+    import uvicorn
+
+    from app.config import Settings
+    from app.main import create_app
+
+    root = tmp_path_factory.mktemp("setup_support_swivel")
+    scenario = root / "scenario.json"
+    scenario.write_text(json.dumps(SWIVEL))
+    sock = __import__("socket").socket()
+    sock.bind(("127.0.0.1", 0))
+    port = sock.getsockname()[1]
+    sock.close()
+    app = create_app(Settings(db_path=root / "hmi.db", scenario_path=scenario, port=port))
+    srv = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
+    thread = threading.Thread(target=srv.run, daemon=True)
+    thread.start()
+    deadline = time.monotonic() + 15
+    while not srv.started:
+        assert time.monotonic() < deadline, "server did not start"
+        time.sleep(0.05)
+    yield f"http://127.0.0.1:{port}"
+    srv.should_exit = True
+    thread.join(timeout=5)
+
+
+@pytest.fixture
+def http(server):
+    import httpx
+
+    with httpx.Client(base_url=server, timeout=20) as client:
+        yield client
+
+
+@pytest.fixture
+def tab(browser, server):
+    context = browser.new_context(viewport={"width": 1280, "height": 800}, base_url=server)
+    context.set_default_timeout(8000)
+    yield context.new_page()
+    context.close()
+
+
+def load(http) -> SwivelOperator:
+    r = http.post("/api/sim/scenario", json={**SWIVEL, "reset_data": True})
+    assert r.status_code == 200, r.text
+    return SwivelOperator(http, SWIVEL)
+
+
+def post(http, url, body=None) -> dict:
+    r = http.post(url, json=body or {})
+    assert r.status_code == 200, r.text
+    return r.json()
+
+
+def measure(http, op, task, params, starts, target=None) -> dict:
+    session = post(http, "/api/measure", {"task": task, "params": params, "target": target})
+    answer = None
+    for p in starts:
+        op.ball_to(p)
+        answer = post(http, f"/api/measure/{session['id']}/start")
+    if len(starts) > 1:
+        answer = post(http, f"/api/measure/{session['id']}/calculate")
+    answer["_session"] = session["id"]
+    return answer
+
+
+def angle_deg(u, v) -> float:
+    return math.degrees(math.acos(min(1.0, float(np.dot(u, v)) / float(np.linalg.norm(u) * np.linalg.norm(v)))))
+
+
+def test_example2_orient_plane_with_swivel(tab, http):
+    op = load(http)
+    http.post("/api/machine/activate", json={"offset": "G500"})
+    answer = measure(http, op, "plane.align", {}, TOP_POINTS, target="G54")
+    tab.goto(f"/measure/setup-support/{answer['_session']}")
+    expect(tab.locator("#ss-top-line")).to_have_text("The new WCS needs a new alignment!")
+    expect(tab.locator('[data-toggle="realign"] select')).to_be_enabled()
+    expect(tab.locator('[data-toggle="realign"] select')).to_have_value("yes")
+    expect(tab.locator('[data-toggle="retract"] select')).to_have_value("yes")
+    expect(tab.locator('[data-toggle="retract"]')).to_contain_text("dry run")
+    expect(tab.locator(".ss-message")).to_have_count(0)            # re-alignment is possible here
+    # the top line follows the answers (spec §6.2 example 2)
+    tab.locator('[data-toggle="realign"] select').select_option("no")
+    expect(tab.locator("#ss-top-line")).to_have_text("You are compensating in an inactive WO!")
+    tab.locator('[data-toggle="retract"] select').select_option("no")
+    tab.locator('[data-toggle="realign"] select').select_option("yes")
+    expect(tab.locator("#ss-top-line")).to_have_text("The new WCS needs a new alignment!")
+    tab.locator('[data-toggle="retract"] select').select_option("yes")
+    expect(tab.locator("#ss-dialog")).to_have_text("Press NC Start to activate!")
+    tab.screenshot(path="/tmp/setup_support_swivel.png", full_page=True)
+    tab.locator("#nc-start").click()
+    tab.wait_for_url("**/measure/workpiece/plane")
+    status = http.get("/api/machine").json()
+    assert status["active_offset"] == "G54"
+    assert status["mcs"]["Z"] == pytest.approx(SWIVEL["machine"]["limits"]["Z"][1])   # retracted
+    normal = rpy(SWIVEL["workpiece"]["pose"]["rot"])[:, 2]                           # the truth
+    assert angle_deg(status["tool_axis"], normal) < 1e-6
+    assert angle_deg(op.head()[:, 2], normal) < 1e-6                                  # the head model
+
+
+def test_guided_tilted_setup_one_pass(tab, http):
+    op = load(http)
+    tab.goto("/measure/workpiece")
+    tab.locator('#vsoftkeys .softkey:has-text("Tilted set-up")').click()
+    tab.wait_for_url("**/measure/workpiece/tilted-setup")
+    tab.locator("#ts-target").select_option("G54")
+    tab.locator("#ts-start-button").click()
+    expect(tab.locator('[data-step="1"]')).to_have_attribute("data-done", "no")
+    # 1 orient plane: the step activates G500; the operator selects Zero offset = G54 and measures
+    tab.locator("#ts-open-1").click()
+    tab.wait_for_url("**/measure/workpiece/plane")
+    assert http.get("/api/machine").json()["active_offset"] == "G500"
+    answer = measure(http, op, "plane.align", {}, TOP_POINTS, target="G54")
+    tab.goto("/measure/workpiece/tilted-setup")
+    expect(tab.locator('[data-step="1"]')).to_have_attribute("data-done", "yes")
+    # 2 set-up support: activate + retract + re-align (NC Start on the activation screen)
+    tab.locator("#ts-open-2").click()
+    tab.wait_for_url(f"**/measure/setup-support/{answer['_session']}")
+    tab.locator("#nc-start").click()
+    tab.wait_for_url("**/measure/workpiece/plane")
+    tab.goto("/measure/workpiece/tilted-setup")
+    expect(tab.locator('[data-step="2"]')).to_have_attribute("data-done", "yes")
+    expect(tab.locator("#ts-jm-i6")).to_have_text("G54")
+    expect(tab.locator("#ts-state")).to_contain_text("perpendicular to the plane")
+    # 3 corner in the tilted plane: the input screen's Zero offset is preset to the proposal G54
+    tab.locator("#ts-open-3").click()
+    tab.wait_for_url("**/measure/workpiece/corner/right")
+    expect(tab.locator('select[name="target"]')).to_have_value("G54")
+    measure(http, op, "corner.right", {"kind": "outside", "position": 1, "setpoint": {"X": 0, "Y": 0}},
+            [(40, -8, -6), (150, -8, -6), (-8, 50, -6)], target="G54")
+    tab.goto("/measure/workpiece/tilted-setup")
+    expect(tab.locator('[data-step="3"]')).to_have_attribute("data-done", "yes")
+    # 4 set edge Z
+    tab.locator("#ts-open-4").click()
+    tab.wait_for_url("**/measure/workpiece/edge/set")
+    expect(tab.locator('select[name="target"]')).to_have_value("G54")
+    measure(http, op, "edge.set", {"axis": "Z", "direction": "-", "setpoint": 0}, [(100, 60, 6)], target="G54")
+    tab.goto("/measure/workpiece/tilted-setup")
+    expect(tab.locator("#screen")).to_have_attribute("data-complete", "yes")
+    expect(tab.locator("#ts-complete")).to_be_visible()
+    tab.screenshot(path="/tmp/tilted_setup.png", full_page=True)
+    # the G54 shown equals the hidden pose (noise-free probe)
+    g54 = http.get("/api/offsets/G54").json()
+    rot_err, trans_err = pose_errors(g54, SWIVEL)
+    assert rot_err < 1e-6 and trans_err < 1e-6
+    shown_x = float(tab.locator('#ts-result [data-field="trans.X"]').inner_text())
+    assert shown_x == pytest.approx(SWIVEL["workpiece"]["pose"]["trans"][0], abs=1e-4)
