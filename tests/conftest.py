@@ -3,16 +3,11 @@
 from __future__ import annotations
 
 import json
-import socket
-import threading
-import time
 
 import pytest
 from fastapi.testclient import TestClient
 from hmi_testdata import TEST_SCENARIO, test_scenario
-
-CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                 "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+from live import CHROMIUM_ARGS, serve
 
 
 @pytest.fixture
@@ -39,36 +34,11 @@ def client(app):
 
 # --- end to end -------------------------------------------------------------------------
 
-def _free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
-
-
 @pytest.fixture(scope="session")
 def live_server(tmp_path_factory):
     """The app served by uvicorn in a thread; yields its base URL."""
-    import uvicorn
-
-    from app.config import Settings
-    from app.main import create_app
-
-    root = tmp_path_factory.mktemp("live")
-    scenario = root / "scenario.json"
-    scenario.write_text(json.dumps(TEST_SCENARIO))
-    port = _free_port()
-    app = create_app(Settings(db_path=root / "hmi.db", scenario_path=scenario, port=port))
-    server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
-    thread = threading.Thread(target=server.run, daemon=True)
-    thread.start()
-    deadline = time.monotonic() + 15
-    while not server.started:
-        if time.monotonic() > deadline:
-            raise RuntimeError("live server did not start")
-        time.sleep(0.05)
-    yield f"http://127.0.0.1:{port}"
-    server.should_exit = True
-    thread.join(timeout=5)
+    with serve(tmp_path_factory.mktemp("live"), TEST_SCENARIO) as url:
+        yield url
 
 
 @pytest.fixture(scope="session")

@@ -10,13 +10,11 @@ the truth, tests/flows/test_chain_truth.Operator); the activation screen is driv
 from __future__ import annotations
 
 import copy
-import json
 import sys
-import threading
-import time
 from pathlib import Path
 
 import pytest
+from live import serve
 from playwright.sync_api import expect
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "flows"))
@@ -39,29 +37,8 @@ TILTED["workpiece"]["pose"]["rot"] = [2.0, -1.5, 4.0]
 
 @pytest.fixture(scope="module")
 def server(tmp_path_factory):
-    import uvicorn
-
-    from app.config import Settings
-    from app.main import create_app
-
-    root = tmp_path_factory.mktemp("setup_support")
-    scenario = root / "scenario.json"
-    scenario.write_text(json.dumps(FLAT))
-    sock_port = __import__("socket").socket()
-    sock_port.bind(("127.0.0.1", 0))
-    port = sock_port.getsockname()[1]
-    sock_port.close()
-    app = create_app(Settings(db_path=root / "hmi.db", scenario_path=scenario, port=port))
-    srv = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
-    thread = threading.Thread(target=srv.run, daemon=True)
-    thread.start()
-    deadline = time.monotonic() + 15
-    while not srv.started:
-        assert time.monotonic() < deadline, "server did not start"
-        time.sleep(0.05)
-    yield f"http://127.0.0.1:{port}"
-    srv.should_exit = True
-    thread.join(timeout=5)
+    with serve(tmp_path_factory.mktemp("setup_support"), FLAT) as url:
+        yield url
 
 
 @pytest.fixture

@@ -8,15 +8,13 @@ Truth: the scenario pose (the plane's normal, the part's position).
 
 from __future__ import annotations
 
-import json
 import math
 import sys
-import threading
-import time
 from pathlib import Path
 
 import numpy as np
 import pytest
+from live import serve
 from playwright.sync_api import expect
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "flows"))
@@ -29,29 +27,8 @@ SWIVEL = swivel(CHAIN_SCENARIO, ("A", "B"))
 
 @pytest.fixture(scope="module")
 def server(tmp_path_factory):
-    import uvicorn
-
-    from app.config import Settings
-    from app.main import create_app
-
-    root = tmp_path_factory.mktemp("setup_support_swivel")
-    scenario = root / "scenario.json"
-    scenario.write_text(json.dumps(SWIVEL))
-    sock = __import__("socket").socket()
-    sock.bind(("127.0.0.1", 0))
-    port = sock.getsockname()[1]
-    sock.close()
-    app = create_app(Settings(db_path=root / "hmi.db", scenario_path=scenario, port=port))
-    srv = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
-    thread = threading.Thread(target=srv.run, daemon=True)
-    thread.start()
-    deadline = time.monotonic() + 15
-    while not srv.started:
-        assert time.monotonic() < deadline, "server did not start"
-        time.sleep(0.05)
-    yield f"http://127.0.0.1:{port}"
-    srv.should_exit = True
-    thread.join(timeout=5)
+    with serve(tmp_path_factory.mktemp("setup_support_swivel"), SWIVEL) as url:
+        yield url
 
 
 @pytest.fixture

@@ -1,0 +1,48 @@
+"""A real HMI served by uvicorn in a thread, for the Playwright tests (one helper, many fixtures)."""
+
+from __future__ import annotations
+
+import json
+import socket
+import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                 "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+
+
+def free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+@contextmanager
+def serve(root: Path, scenario: dict, start_timeout_s: float = 15.0) -> Iterator[str]:
+    """Serve the app on a free loopback port with a fresh db under ``root``; yields the base URL."""
+    import uvicorn
+
+    from app.config import Settings
+    from app.main import create_app
+
+    root.mkdir(parents=True, exist_ok=True)
+    scenario_path = root / "scenario.json"
+    scenario_path.write_text(json.dumps(scenario))
+    port = free_port()
+    app = create_app(Settings(db_path=root / "hmi.db", scenario_path=scenario_path, port=port))
+    server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
+    thread = threading.Thread(target=server.run, daemon=True)
+    thread.start()
+    deadline = time.monotonic() + start_timeout_s
+    while not server.started:
+        if time.monotonic() > deadline:
+            raise RuntimeError("live server did not start")
+        time.sleep(0.05)
+    try:
+        yield f"http://127.0.0.1:{port}"
+    finally:
+        server.should_exit = True
+        thread.join(timeout=5)
