@@ -33,7 +33,7 @@ from .task_forms import (
     values_from_params,
 )
 from .task_svg import draw
-from .templating import base_context, is_htmx, render_screen, templates
+from .templating import base_context, fixed, is_htmx, render_screen, templates
 
 router = APIRouter()
 TEMPLATE = "measure_task.html"
@@ -114,7 +114,7 @@ def _fmt(key: str, value) -> str:
     if isinstance(value, bool):
         return "yes" if value else "no"
     if isinstance(value, int | float):
-        return f"{value:.4f}" if key in ANGLE_KEYS else f"{value:.3f}"
+        return fixed(value, 4 if key in ANGLE_KEYS else 3)
     return str(value)
 
 

@@ -44,9 +44,16 @@ def fmt_length(value: float | None, gud: GudSettings, rotary: bool = False) -> s
     return f"{value:.3f}"
 
 
+def fixed(value, decimals: int = 4) -> str:
+    """Fixed-point display without a "-0.0000" for values that round to zero."""
+    text = f"{float(value):.{decimals}f}"
+    return text[1:] if text.startswith("-") and float(text) == 0.0 else text
+
+
 templates = Jinja2Blocks(directory=str(TEMPLATES_DIR))
 templates.env.globals["HORIZONTAL_SOFTKEYS"] = HORIZONTAL_SOFTKEYS
 templates.env.filters["mm"] = fmt_length
+templates.env.filters["fixed"] = fixed
 # macros as a global module, so blocks rendered on their own (htmx partials) can call them
 templates.env.globals["ui"] = templates.env.get_template("macros.html").module
 
