@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import APIRouter, Body, Query
+from fastapi import APIRouter, Body, Path, Query
 
 from app.deps import LogDep, OffsetsDep, ProbesDep, SettingsDep, ToolProbesDep, ToolsDep
 
@@ -104,5 +104,5 @@ def list_log(log: LogDep, limit: Annotated[int, Query(ge=1, le=1000)] = 100) -> 
 
 
 @router.get("/log/{log_id}")
-def get_log(log_id: int, log: LogDep) -> dict:
+def get_log(log_id: Annotated[int, Path(ge=1, le=2**63 - 1)], log: LogDep) -> dict:
     return log.get(log_id)

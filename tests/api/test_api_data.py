@@ -192,3 +192,11 @@ def test_log_lists_entries_written_by_the_workflow(client, app):
         log_id = unit.add_log({"task": "edge.set", "result": {"position": 1.0}})
     assert [e["id"] for e in client.get("/api/log").json()] == [log_id]
     assert client.get(f"/api/log/{log_id}").json()["task"] == "edge.set"
+
+
+def test_log_id_out_of_range_is_a_422_not_a_500(client):
+    """Found by schemathesis: an id beyond SQLite's 64-bit integers used to raise OverflowError."""
+    for bad in ("703894987214326758188777472", "0", "-3"):
+        response = client.get(f"/api/log/{bad}")
+        assert response.status_code == 422, bad
+        assert response.json()["error"]["field"] == "log_id"
