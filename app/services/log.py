@@ -18,6 +18,8 @@ class LogService:
             return unit.list_log(limit)
 
     def get(self, log_id: int) -> dict:
+        if not 1 <= log_id < 2**63:          # SQLite integers are 64-bit; no such entry
+            raise NotFoundError(f"no log entry {log_id}", field="log_id")
         with self._db.unit(readonly=True) as unit:
             entry = unit.get_log(log_id)
         if entry is None:

@@ -118,3 +118,7 @@ def test_log_screen_empty_and_unknown_entry(client):
 
 def test_horizontal_softkey_log(client):
     assert 'href="/log"' in client.get("/jog").text
+
+
+def test_log_detail_of_an_impossible_id_is_not_found(client):
+    assert client.get("/log/99999999999999999999999").status_code == 404
