@@ -108,7 +108,7 @@ def test_press_and_hold_jogs_continuously_until_release(page, api):
     plus.hover()
     page.mouse.down()
     # the test machine runs at time_scale 0: the held key drives Y straight to its limit (500)
-    expect(wcs_value(page, "Y")).to_have_text("500.000")
+    expect(wcs_value(page, "Y")).to_have_text("500.000", timeout=15000)   # generous on a loaded CI box
     page.mouse.up()
     state = api.get("/api/machine").json()
     assert state["busy"] is False and state["mcs"]["Y"] == pytest.approx(500.0)
