@@ -25,6 +25,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from engine.compensation import trigger_radius
+from engine.correction import alpha_beta_from_normal
 from engine.fit import LineFit, fit_circle, fit_line, fit_plane, intersect_lines
 from engine.planes import Plane, axis_index
 from engine.types import (
@@ -74,11 +75,6 @@ def _fold90(deg: float) -> float:
     while deg <= -90.0:
         deg += 180.0
     return deg
-
-
-def _wrap180(deg: float) -> float:
-    wrapped = (deg + 180.0) % 360.0 - 180.0
-    return 180.0 if wrapped == -180.0 else wrapped
 
 
 def _angle_ao(vec_ao) -> float:
@@ -451,9 +447,7 @@ def _plane_align(task, params, points, plane, probe) -> TaskResult:
     normal = fit.normal if fit.normal @ plane.infeed_unit > 0.0 else -fit.normal
     if abs(normal @ plane.infeed_unit) < 1e-12:
         raise MeasuringError(61411, "frame calculation impossible: plane parallel to the infeed")
-    n_a, n_o, n_p = plane.to_aop(normal)
-    alpha = float(np.degrees(np.arcsin(np.clip(-n_o, -1.0, 1.0))))              # §2.9
-    beta = float(np.degrees(np.arctan2(n_a, n_p)))                              # §2.9
+    alpha, beta = alpha_beta_from_normal(normal, plane)                          # §2.9
     values = {"alpha": alpha, "beta": beta,
               "normal": {a: float(v) for a, v in zip(_AXES, normal, strict=True)},
               "points": _touch_values(plane, touches)}

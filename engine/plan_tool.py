@@ -6,25 +6,22 @@ Coordinates: MCS, NC reference = tool tip (steps use coords="MCS"). Tool probe r
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from engine.plan_base import Motion, PlanContext, ToolPoint, ToolProbePoint, ToolTouch, spindle
 from engine.plan_workpiece import Program
+from engine.toolmeasure import probe_centre, spindle_speed_feeds
 from engine.types import MeasuringError
 
 
 def rotating_speed_feeds(radius: float, ctx: PlanContext) -> tuple[float, list[float]]:
-    """Spec §7.3 [I] / math §14.2: n = min(E_MESS_MAX_S, E_MESS_MAX_V/(2π·r·0.001)),
-    F = n·E_MESS_MIN_D; 1st touch min(MAX_F, max(MIN_F, FAK1·F)); FAK2 > 0: FAK2·F; last F."""
-    n = min(ctx.max_spindle_speed, ctx.max_surface_speed / (2.0 * math.pi * radius * 0.001))
-    final = n * ctx.min_accuracy
-    feeds = [min(ctx.max_feed_rotating, max(ctx.min_feed_rotating, ctx.feed_factor1 * final))]
-    if ctx.feed_factor2 > 0.0:
-        feeds.append(ctx.feed_factor2 * final)
-    feeds.append(final)
-    return n, feeds
+    """Speed and stage feeds of a rotating-spindle measurement (engine.toolmeasure, math §14.2)
+    with the GUD7 values of ``ctx``."""
+    sf = spindle_speed_feeds(radius, max_surface_speed=ctx.max_surface_speed,
+                             max_speed=ctx.max_spindle_speed, accuracy=ctx.min_accuracy,
+                             min_feed=ctx.min_feed_rotating, max_feed=ctx.max_feed_rotating,
+                             factor1=ctx.feed_factor1, factor2=ctx.feed_factor2)
+    return sf.speed, list(sf.feeds)
 
 
 def stationary_feeds(ctx: PlanContext) -> list[float]:
@@ -49,11 +46,8 @@ def _tp(ctx: PlanContext, key: str) -> float:
 
 
 def _probe_centre(ctx: PlanContext, axis: str, fallback: float) -> float:
-    """Probe centre on a plane axis = mid of the two trigger values (spec §7.2 table)."""
-    tp = ctx.tool_probe or {}
-    if f"{axis}-" in tp and f"{axis}+" in tp:
-        return 0.5 * (float(tp[f"{axis}-"]) + float(tp[f"{axis}+"]))
-    return fallback
+    """Probe centre on a plane axis (engine.toolmeasure.probe_centre), else ``fallback``."""
+    return probe_centre(ctx.tool_probe or {}).get(axis, fallback)
 
 
 def _touch(key: str, latch, feed: float) -> ToolTouch:

@@ -12,7 +12,7 @@ from collections.abc import Generator
 import numpy as np
 
 from engine.compensation import effective_radius, make_touch, parallel_axis, trigger_key
-from engine.fit import fit_circle
+from engine.evaluate import circle_from_touches, rect_from_touches
 from engine.plan_base import Motion, PlanContext, RingCalibrationPoint, RingPass, spindle
 from engine.planes import Plane
 from engine.types import CirclePoint, EdgePoint, Latch, RectPoint, Step, Touch
@@ -170,74 +170,48 @@ def _touches(latches, dirs, ctx: PlanContext) -> tuple[Touch, ...]:
                             latched_mcs=lt.latched_mcs) for lt, d in zip(latches, dirs, strict=True))
 
 
-def circle_point(touches: tuple[Touch, ...], u1: np.ndarray, u2: np.ndarray, ctx: PlanContext,
-                 inner: bool) -> CirclePoint:
-    """Centre/diameter from the 2nd-pass touches (+u1, −u1, +u2, −u2), both chords diameters.
-
-    Axis-parallel: centre = mid-points of opposite surface points (measuring-math §8.3, per
-    direction trigger values), D = mean of the two chords. Angled: circle fit of the ball
-    centres, R = R_c + ρ (bore) / R_c − ρ (spigot) (measuring-math §5.3, exact at any angle).
-    """
-    p = ctx.plane.infeed_unit
-    height = float(np.mean([t.ball_centre @ p for t in touches]))
-    if all(parallel_axis(t.direction) is not None for t in touches):
-        s1, s2, s3, s4 = (t.surface for t in touches)
-        c1, c2 = float(0.5 * (s1 + s2) @ u1), float(0.5 * (s3 + s4) @ u2)
-        chords = float((s1 - s2) @ u1) + float((s3 - s4) @ u2)
-        diameter = 0.5 * chords if inner else -0.5 * chords
-        centre = c1 * u1 + c2 * u2 + height * p
-    else:
-        a, o = ctx.plane.unit(ctx.plane.first), ctx.plane.unit(ctx.plane.second)
-        fit = fit_circle(np.array([[t.ball_centre @ a, t.ball_centre @ o] for t in touches]))
-        rho = effective_radius(ctx.probe)
-        diameter = 2.0 * (fit.radius + rho if inner else fit.radius - rho)
-        centre = fit.center[0] * a + fit.center[1] * o + height * p
-    return CirclePoint(center=centre, diameter=float(diameter), touches=touches)
+def circle_point(touches: tuple[Touch, ...], ctx: PlanContext, inner: bool) -> CirclePoint:
+    """Centre/diameter of the 2nd-pass touches (+u1, −u1, +u2, −u2) as the evaluation
+    computes them (engine.evaluate.circle_from_touches, measuring-math §8.3)."""
+    centre, diameter = circle_from_touches(touches, ctx.plane, "hole" if inner else "spigot", ctx.probe)
+    return CirclePoint(center=centre, diameter=diameter, touches=touches)
 
 
 def rect_point(touches: tuple[Touch, ...], ctx: PlanContext, inner: bool) -> RectPoint:
-    """L, W, centre from ±1st, ±2nd surface points (measuring-math §8.3 rectangles)."""
-    a, o = ctx.plane.unit(ctx.plane.first), ctx.plane.unit(ctx.plane.second)
-    p = ctx.plane.infeed_unit
-    s1, s2, s3, s4 = (t.surface for t in touches)
-    sign = 1.0 if inner else -1.0       # inner: La = s1 − s2; outer: La = s2 − s1
-    centre = (float(0.5 * (s1 + s2) @ a) * a + float(0.5 * (s3 + s4) @ o) * o
-              + float(np.mean([t.ball_centre @ p for t in touches])) * p)
-    return RectPoint(center=centre, length=sign * float((s1 - s2) @ a),
-                     width=sign * float((s3 - s4) @ o), touches=touches)
+    """L, W, centre from ±1st, ±2nd touches (engine.evaluate.rect_from_touches, math §8.3)."""
+    centre, length, width = rect_from_touches(touches, ctx.plane, "pocket" if inner else "spigot")
+    return RectPoint(center=centre, length=length, width=width, touches=touches)
 
 
 # --- programs -----------------------------------------------------------------------------------
 
-def hole_program(params: dict, start: np.ndarray, ctx: PlanContext, label: str) -> Program:
-    """Hole at measuring depth (spec §2.7.1): pass 1 finds the centre, pass 2 from the found
-    centre makes every travel line a diameter, so each touch hits the wall at normal incidence —
-    where the calibrated per-direction trigger values hold — and both chords are diameters."""
+def _circle_program(params: dict, start: np.ndarray, ctx: PlanContext, label: str, chord, half,
+                    inner: bool) -> Program:
+    """Pass 1 finds the centre, pass 2 from the found centre makes every travel line a
+    diameter, so each touch hits the wall at normal incidence — where the calibrated
+    per-direction trigger values hold — and both chords are diameters."""
     m = Motion(start, ctx, ball_offset=ball_offset(ctx))
     u1, u2 = plane_directions(ctx.plane, float(params.get("probe_angle", 0.0)))
-    diameter = params.get("diameter")
-    reach = None if not diameter else diameter / 2.0 - effective_radius(ctx.probe)
-    surf = _surface_of(ctx)
-    _, found = yield from _pass(m, m.start + m.ball_offset, u1, u2, _inner_chord, (reach, reach),
-                                f"{label} pass 1", surf)
-    latches, _ = yield from _pass(m, found, u1, u2, _inner_chord, (reach, reach), f"{label} pass 2", surf)
-    yield from m.back(m.start)
-    return circle_point(_touches(latches, (u1, -u1, u2, -u2), ctx), u1, u2, ctx, inner=True)
-
-
-def spigot_program(params: dict, start: np.ndarray, ctx: PlanContext, label: str) -> Program:
-    """Circular spigot from above (spec §2.8): outer path per direction, then a 2nd pass through
-    the found centre (normal incidence, as for holes)."""
-    m = Motion(start, ctx, ball_offset=ball_offset(ctx))
-    u1, u2 = plane_directions(ctx.plane, float(params.get("probe_angle", 0.0)))
-    half = params["diameter"] / 2.0
-    chord = _outer_chord_factory(float(params["infeed"]))
     surf = _surface_of(ctx)
     _, found = yield from _pass(m, m.start + m.ball_offset, u1, u2, chord, (half, half),
                                 f"{label} pass 1", surf)
     latches, _ = yield from _pass(m, found, u1, u2, chord, (half, half), f"{label} pass 2", surf)
     yield from m.back(m.start)
-    return circle_point(_touches(latches, (u1, -u1, u2, -u2), ctx), u1, u2, ctx, inner=False)
+    return circle_point(_touches(latches, (u1, -u1, u2, -u2), ctx), ctx, inner)
+
+
+def hole_program(params: dict, start: np.ndarray, ctx: PlanContext, label: str) -> Program:
+    """Hole at measuring depth (spec §2.7.1), inner chords from the centre."""
+    diameter = params.get("diameter")
+    reach = None if not diameter else diameter / 2.0 - effective_radius(ctx.probe)
+    return (yield from _circle_program(params, start, ctx, label, _inner_chord, reach, inner=True))
+
+
+def spigot_program(params: dict, start: np.ndarray, ctx: PlanContext, label: str) -> Program:
+    """Circular spigot from above (spec §2.8): outer path per direction (down DZ, probe inward)."""
+    chord = _outer_chord_factory(float(params["infeed"]))
+    return (yield from _circle_program(params, start, ctx, label, chord, params["diameter"] / 2.0,
+                                       inner=False))
 
 
 def rect_program(params: dict, start: np.ndarray, ctx: PlanContext, label: str, inner: bool) -> Program:
