@@ -45,15 +45,6 @@ class ProbeRecord:
     calibration_feed: float | None = None
     calibration_override: float | None = None
 
-    def trigger_value(self, direction: str) -> float:
-        """t(dir); falls back to the ideal ball (±r) when not calibrated."""
-        if direction in self.trigger:
-            return self.trigger[direction]
-        r = self.ball_diameter / 2.0
-        if direction == "Z-" and self.length_to_tip:
-            return 0.0
-        return r if direction.endswith("-") else -r
-
 
 # --- what one measuring point stores (P1..P4) ------------------------------------------
 
