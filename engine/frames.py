@@ -149,11 +149,6 @@ class Frame:
                     and np.allclose(self.rotation, other.rotation, rtol=0.0, atol=tol)
                     and all(abs(self.rotary_offset(k) - other.rotary_offset(k)) <= tol for k in keys))
 
-    @property
-    def is_identity(self) -> bool:
-        return (not np.any(self.translation) and not np.any(self.rot)
-                and not any(v for _, v in self.rotary))
-
     def as_matrix(self) -> np.ndarray:
         """4x4 homogeneous child2parent matrix."""
         m = np.eye(4)
@@ -236,9 +231,9 @@ class FrameChain:
     basic: tuple[Frame, ...] = ()
     settable: Frame = field(default_factory=Frame.identity)
 
-    @property
+    @cached_property
     def below_settable(self) -> Frame:
-        """Parent of the settable frame -> BCS (everything outside G54..)."""
+        """Parent of the settable frame -> BCS (everything outside G54..); composed once."""
         return compose_chain([self.setframe, *self.basic])
 
     @cached_property

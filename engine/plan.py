@@ -8,8 +8,9 @@ returns the stored point. Contracts and probing helpers: ``engine.plan_base``; g
 
 from __future__ import annotations
 
+import contextlib
 import math
-from collections.abc import Generator
+from collections.abc import Callable, Generator
 
 import numpy as np
 
@@ -40,7 +41,7 @@ from engine.types import Latch, MeasuringError, MoveStep, ProbeStep, Step
 __all__ = [
     "TASK_POINTS", "ParamError", "PlanContext", "RingCalibrationPoint", "RingPass", "ToolPoint",
     "ToolProbePoint", "ToolTouch", "corner_direction", "hit", "planned_path", "point_program",
-    "validate_params",
+    "run_program", "validate_params",
 ]
 
 ROTARY_AXES = ("A", "B", "C")   # design.md §3: optional rotary axes
@@ -240,30 +241,41 @@ def point_program(task: str, params: dict, n: int, start: np.ndarray, ctx: PlanC
     return tool_diameter_program(params, start, ctx, label)
 
 
+def run_program(program: Generator[Step, Latch | None, object],
+                respond: Callable[[Step], Latch | None], steps: list[Step] | None = None) -> object:
+    """Drive a point program: each step goes to ``respond``, whose answer (a Latch for a
+    ProbeStep, None otherwise) is sent back; returns the stored point. ``steps`` collects the
+    yielded steps (also those before an exception of the program)."""
+    reply: Latch | None = None
+    try:
+        while True:
+            step = program.send(reply)
+            if steps is not None:
+                steps.append(step)
+            reply = respond(step)
+    except StopIteration as done:
+        return done.value
+
+
 def planned_path(task: str, params: dict, n: int, start: np.ndarray, ctx: PlanContext) -> list[Step]:
     """The program driven with ideal latches, for the live preview (never raises on hits).
 
     Every ProbeStep switches at its ``expected`` travel (nominal geometry; halfway when
     unknown). A MeasuringError of the program (e.g. missing tool probe data) ends the list.
     """
-    steps: list[Step] = []
-    program = point_program(task, params, n, start, ctx)
     pos = np.asarray(start, dtype=float)
-    reply: Latch | None = None
-    try:
-        while True:
-            step = program.send(reply)
-            steps.append(step)
-            reply = None
-            if isinstance(step, MoveStep):
-                pos = np.asarray(step.target, dtype=float)
-            elif isinstance(step, ProbeStep):
-                travel = step.expected if step.expected is not None else step.distance / 2.0
-                pos = pos + travel * np.asarray(step.direction, dtype=float)
-                reply = Latch(triggered=True, rec=pos.copy())
-    except StopIteration:
-        pass
-    except MeasuringError:
-        pass
-    return steps
 
+    def ideal(step: Step) -> Latch | None:
+        nonlocal pos
+        if isinstance(step, MoveStep):
+            pos = np.asarray(step.target, dtype=float)
+        elif isinstance(step, ProbeStep):
+            travel = step.expected if step.expected is not None else step.distance / 2.0
+            pos = pos + travel * np.asarray(step.direction, dtype=float)
+            return Latch(triggered=True, rec=pos.copy())
+        return None
+
+    steps: list[Step] = []
+    with contextlib.suppress(MeasuringError):
+        run_program(point_program(task, params, n, start, ctx), ideal, steps)
+    return steps

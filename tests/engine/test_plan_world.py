@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from engine.frames import rot_z
+from engine.plan import run_program
 from engine.types import Latch, MoveStep, ProbeStep, SpindleStep
 
 
@@ -31,6 +32,23 @@ class HalfSpace:
         return t if t >= -1e-12 else None
 
 
+def _cylinder_roots(centre, p, c0, d, radius):
+    """Travel t (ascending) at which c0 + t·d lies at ``radius`` from the axis (centre, p);
+    None when the travel is along the axis or misses the circle."""
+    rel = c0 - centre
+    rel = rel - float(rel @ p) * p
+    dd = d - float(d @ p) * p
+    a = float(dd @ dd)
+    if a == 0.0:
+        return None
+    b = 2.0 * float(rel @ dd)
+    c = float(rel @ rel) - radius ** 2
+    disc = b * b - 4 * a * c
+    if disc < 0:
+        return None
+    return (-b - np.sqrt(disc)) / (2 * a), (-b + np.sqrt(disc)) / (2 * a)
+
+
 @dataclass
 class Bore:
     """Inner cylinder (axis along ``p``) of radius R around ``centre``; the ball moves inside."""
@@ -40,16 +58,8 @@ class Bore:
     p: np.ndarray
 
     def contact(self, c0, d, r):
-        rel = c0 - self.centre
-        rel = rel - float(rel @ self.p) * self.p
-        dd = d - float(d @ self.p) * self.p
-        a = float(dd @ dd)
-        if a == 0.0:
-            return None
-        b = 2.0 * float(rel @ dd)
-        c = float(rel @ rel) - (self.radius - r) ** 2
-        disc = b * b - 4 * a * c
-        return (-b + np.sqrt(disc)) / (2 * a)
+        roots = _cylinder_roots(self.centre, self.p, c0, d, self.radius - r)
+        return None if roots is None else roots[1]          # leaving the inner circle
 
 
 @dataclass
@@ -64,18 +74,10 @@ class Spigot:
     def contact(self, c0, d, r):
         if float(c0 @ self.p) >= self.top:
             return None
-        rel = c0 - self.centre
-        rel = rel - float(rel @ self.p) * self.p
-        dd = d - float(d @ self.p) * self.p
-        a = float(dd @ dd)
-        if a == 0.0:
+        roots = _cylinder_roots(self.centre, self.p, c0, d, self.radius + r)
+        if roots is None:
             return None
-        b = 2.0 * float(rel @ dd)
-        c = float(rel @ rel) - (self.radius + r) ** 2
-        disc = b * b - 4 * a * c
-        if disc < 0:
-            return None
-        t = (-b - np.sqrt(disc)) / (2 * a)
+        t = roots[0]                                        # entering the outer circle
         return t if t >= -1e-12 else None
 
 
@@ -113,30 +115,28 @@ class World:
 def drive(program, start, world: World):
     """Run a point program against the world; returns (stored point, steps)."""
     pos = np.asarray(start, dtype=float)
-    steps, reply = [], None
-    try:
-        while True:
-            step = program.send(reply)
-            steps.append(step)
-            reply = None
-            if isinstance(step, MoveStep):
-                world.moves.append((pos.copy(), np.asarray(step.target, float).copy(), world.spindle_angle))
-                pos = np.asarray(step.target, dtype=float)
-            elif isinstance(step, SpindleStep):
-                if step.angle is not None:
-                    world.spindle_angle = step.angle
-                if step.speed is not None:
-                    world.spindle_speed = step.speed
-            elif isinstance(step, ProbeStep):
-                d = np.asarray(step.direction, float)
-                t = world.switch(pos, d, step.distance)
-                world.probes.append((pos.copy(), step))
-                if world.miss > 0 or t is None:
-                    world.miss -= 1
-                    pos = pos + step.distance * d
-                    reply = Latch(triggered=False)
-                else:
-                    pos = pos + t * d
-                    reply = Latch(triggered=True, rec=pos.copy(), latched_mcs=pos.copy())
-    except StopIteration as done:
-        return done.value, steps
+
+    def respond(step):
+        nonlocal pos
+        if isinstance(step, MoveStep):
+            world.moves.append((pos.copy(), np.asarray(step.target, float).copy(), world.spindle_angle))
+            pos = np.asarray(step.target, dtype=float)
+        elif isinstance(step, SpindleStep):
+            if step.angle is not None:
+                world.spindle_angle = step.angle
+            if step.speed is not None:
+                world.spindle_speed = step.speed
+        elif isinstance(step, ProbeStep):
+            d = np.asarray(step.direction, float)
+            t = world.switch(pos, d, step.distance)
+            world.probes.append((pos.copy(), step))
+            if world.miss > 0 or t is None:
+                world.miss -= 1
+                pos = pos + step.distance * d
+                return Latch(triggered=False)
+            pos = pos + t * d
+            return Latch(triggered=True, rec=pos.copy(), latched_mcs=pos.copy())
+        return None
+
+    steps: list = []
+    return run_program(program, respond, steps), steps
