@@ -44,8 +44,10 @@ def test_speed_limits_and_first_feed():
     assert sf.speed == 1000.0
     assert sf.final_feed == pytest.approx(10.0)
     assert sf.feeds == pytest.approx((20.0, 10.0))   # 10·10 = 100 clamped to MAX_F
-    big = spindle_speed_feeds(100.0)              # n = 159.15, F = 1.59, first = 15.9
-    assert big.feeds == pytest.approx((10 * 1.5915494, 1.5915494), abs=1e-6)
+    big = spindle_speed_feeds(100.0)              # n = 100 m/min / (2π·0.1 m) = 159.15, F = 1.59
+    n = 100.0 / (2.0 * math.pi * 0.1)
+    assert big.speed == pytest.approx(n, rel=1e-12)
+    assert big.feeds == pytest.approx((10 * 0.01 * n, 0.01 * n), rel=1e-12)
     tiny = spindle_speed_feeds(100.0, accuracy=0.0005)   # F = 0.0796, 10·F < MIN_F -> 1
     assert tiny.feeds[0] == 1.0
     three = spindle_speed_feeds(100.0, factor2=3.0)
