@@ -4,12 +4,11 @@ import time
 
 from app.machine.scenario import demo_scenario
 from app.machine.sim import SimulatedMachine
+from app.services.scenarios import with_time_scale
 
 
 def main(repeats: int = 200) -> None:
-    scenario = demo_scenario().model_copy(update={"machine": demo_scenario().machine.model_copy(
-        update={"time_scale": 0.0})})
-    machine = SimulatedMachine(scenario)
+    machine = SimulatedMachine(with_time_scale(demo_scenario(), 0.0))
     start = machine.status().mcs
     t0 = time.perf_counter()
     for _ in range(repeats):

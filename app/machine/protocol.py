@@ -15,8 +15,8 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-# Alarm numbers used by the machine (spec/jog-measuring.md §10).
-ALARM_PROBE_NOT_SWITCHED = 61301
+# Alarm numbers used by the machine (spec/jog-measuring.md §10). 61301 "probe not switched" is
+# not one of them: a probe() without a switch is no fault of the machine, the measuring tasks raise it.
 ALARM_PROBE_COLLISION = 61302
 ALARM_LIMIT = 21614            # "software limit switch" style alarm of the NC
 ALARM_PROBE_BROKEN = 61302     # overtravel beyond the permissible deflection (measuring-math §1.3);
@@ -135,8 +135,3 @@ class Machine(Protocol):
 
     @property
     def axes(self) -> tuple[str, ...]: ...
-
-
-def vec(d: dict[str, float], axes=("X", "Y", "Z")) -> np.ndarray:
-    """Helper: axis dict -> numpy vector."""
-    return np.array([float(d[a]) for a in axes])

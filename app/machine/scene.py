@@ -247,6 +247,13 @@ def workpiece_pose(scenario, table_angle: float = 0.0) -> tuple[np.ndarray, np.n
     return turn @ rot, turn @ (trans - centre) + centre
 
 
+def _cut_from_top(depth: float, block_height: float) -> tuple[float, float]:
+    """(mid z, half height) in part coordinates of a cut-out from ``depth`` below the top face up
+    into the air; through the block when at least as deep as the block."""
+    bottom = -_EXTEND if depth >= block_height else -depth
+    return (_EXTEND + bottom) / 2.0, (_EXTEND - bottom) / 2.0
+
+
 def build_scene(scenario, table_angle: float = 0.0) -> Scene:
     """The scenario's true solids (design.md §4 field meanings) as a Scene in MCS."""
     bodies: list[Body] = []
@@ -264,12 +271,10 @@ def build_scene(scenario, table_angle: float = 0.0) -> Scene:
         extras: list[Body] = []
         for f in wp.features:
             if f.type == "hole":
-                bottom = -_EXTEND if f.depth >= lz else -f.depth       # through hole when deep enough
-                mid, half = (_EXTEND + bottom) / 2.0, (_EXTEND - bottom) / 2.0
+                mid, half = _cut_from_top(f.depth, lz)
                 cutouts.append(Cylinder(rot, place([f.center[0], f.center[1], mid]), f.diameter / 2, half))
             elif f.type == "pocket":
-                bottom = -_EXTEND if f.depth >= lz else -f.depth
-                mid, half = (_EXTEND + bottom) / 2.0, (_EXTEND - bottom) / 2.0
+                mid, half = _cut_from_top(f.depth, lz)
                 cutouts.append(Box(rot, place([f.center[0], f.center[1], mid]),
                                    [f.size[0] / 2, f.size[1] / 2, half]))
             elif f.type == "spigot":
@@ -290,6 +295,45 @@ def build_scene(scenario, table_angle: float = 0.0) -> Scene:
     if tp is not None:
         bodies.append(Body("tool_probe", tool_probe_cylinder(tp)))
     return Scene(bodies)
+
+
+def outline(scenario, table_angle: float = 0.0) -> dict:
+    """The true solids for the machine view (JSON-ready, MCS): block corners, circles, rects."""
+    out: dict = {"block": None, "circles": [], "rects": []}
+    wp = scenario.workpiece
+    if wp is not None and wp.block is not None:
+        rot, trans = workpiece_pose(scenario, table_angle)
+
+        def place(x: float, y: float, z: float) -> list[float]:
+            return [float(v) for v in rot @ np.array([x, y, z]) + trans]
+
+        axis = [float(v) for v in rot[:, 2]]          # the part's z axis
+        lx, ly, lz = wp.block.size
+        out["block"] = {"corners": [place(x, y, z) for z in (0.0, -lz) for x, y in
+                                    ((0, 0), (lx, 0), (lx, ly), (0, ly))]}
+        for f in wp.features:
+            if f.type in ("hole", "spigot"):
+                top = 0.0 if f.type == "hole" else f.height
+                height = f.depth if f.type == "hole" else f.height
+                out["circles"].append({"kind": f.type, "center": place(f.center[0], f.center[1], top),
+                                       "axis": axis, "diameter": f.diameter, "height": height})
+            elif f.type in ("pocket", "boss"):
+                top = 0.0 if f.type == "pocket" else f.height
+                hx, hy = f.size[0] / 2, f.size[1] / 2
+                cx, cy = f.center
+                out["rects"].append({"kind": f.type, "corners": [
+                    place(cx + sx * hx, cy + sy * hy, top) for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))]})
+    up = [0.0, 0.0, 1.0]
+    if scenario.ring_gauge is not None:
+        ring = scenario.ring_gauge
+        for kind, dia in (("ring_bore", ring.diameter), ("ring_outer", ring.outer_diameter)):
+            out["circles"].append({"kind": kind, "center": list(ring.center), "axis": up,
+                                   "diameter": dia, "height": ring.height})
+    if scenario.tool_probe is not None:
+        tp = scenario.tool_probe
+        out["circles"].append({"kind": "tool_probe", "center": list(tp.center), "axis": up,
+                               "diameter": tp.disc_diameter, "height": tp.height})
+    return out
 
 
 def tool_probe_cylinder(tool_probe, grow_radius: float = 0.0, grow_down: float = 0.0) -> Cylinder:

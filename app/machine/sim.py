@@ -73,7 +73,7 @@ from .protocol import (
     ProbeResult,
 )
 from .scenario import GEOMETRY_AXES, Scenario
-from .scene import Body, Scene, build_scene, tool_probe_cylinder, workpiece_pose
+from .scene import Body, Scene, build_scene, outline, tool_probe_cylinder
 
 ALARM_NO_TOOL = 61343         # "no tool for the given tool identifier" (spec/jog-measuring.md §10)
 TICK_S = 0.01                 # motion update period at time_scale > 0
@@ -121,7 +121,6 @@ class SimulatedMachine:
             self._spindle_angle = 0.0
             self._spindle_speed = 0.0
             self._alarms: list[Alarm] = []
-            self._probe_broken = False
             self._rng = np.random.default_rng(scenario.seed)
             self._sync_table()
 
@@ -174,8 +173,8 @@ class SimulatedMachine:
                 raise MachineBusy("tool change while the axes move")
             self._tool = tool
             self._offset_length = offset_length
-            self._probe_broken = False
-            self._alarms = [a for a in self._alarms if a.resettable or a.code != ALARM_PROBE_BROKEN]
+            broken = self._broken_alarm()
+            self._alarms = [a for a in self._alarms if a is not broken]
 
     def set_tool_offset(self, offset_length: float) -> None:
         with self._lock:
@@ -236,7 +235,7 @@ class SimulatedMachine:
             feed = _positive(feed, "feed")
         self._begin()
         try:
-            return self._move_and_turn(target, feed, rapid=feed is None)
+            return self._move_and_turn(target, feed)
         finally:
             self._finish()
 
@@ -247,9 +246,9 @@ class SimulatedMachine:
         feed = self._scenario.machine.jog_feed if feed is None else _positive(feed, "feed")
         self._begin()
         try:
-            target = self._pos.copy()
+            target = self._pos.copy()       # read after _begin: never a point of a running motion
             target[index] += distance
-            return self._move_and_turn(target, feed, rapid=False)
+            return self._move_and_turn(target, feed)
         finally:
             self._finish()
 
@@ -266,7 +265,7 @@ class SimulatedMachine:
 
         def run() -> None:
             try:
-                result = self._move_and_turn(target, feed, rapid=False)
+                result = self._move_and_turn(target, feed)
                 if result.completed:   # ran onto the software limit
                     self._raise_alarm(Alarm(ALARM_LIMIT, f"Axis {axis} at software limit switch"))
             finally:
@@ -300,9 +299,8 @@ class SimulatedMachine:
                 reached, outcome = self._travel(start, self._along(start, d, event.s_contact), feed)
                 self._raise_if_aborted(outcome)
                 raise MachineAlarm(self._raise_alarm(Alarm(ALARM_PROBE_COLLISION, event.text)))
-            cfg = self._scenario.machine
-            s_stop = min(event.s_switch + braking_distance(v, cfg.latency_s, cfg.decel, cfg.kv), distance)
-            s_latch = min(event.s_switch + latency_path(v, cfg.latency_s), s_stop)
+            s_stop = min(event.s_switch + self._braking(v), distance)
+            s_latch = min(event.s_switch + latency_path(v, self._scenario.machine.latency_s), s_stop)
             sigma = self._scenario.probe.noise_sigma
             if sigma > 0.0 and self._probe_in_spindle():
                 s_latch += float(self._rng.normal(0.0, sigma))
@@ -317,7 +315,7 @@ class SimulatedMachine:
             self._finish()
 
     # --- motion internals ----------------------------------------------------------------
-    def _move_and_turn(self, target: np.ndarray, feed: float | None, rapid: bool) -> MoveResult:
+    def _move_and_turn(self, target: np.ndarray, feed: float | None) -> MoveResult:
         """``_move``, then the part follows the rotary table axis (scenario machine.rotary_table).
 
         Simplification: the path is checked with the part where it stood at the start of the
@@ -327,15 +325,13 @@ class SimulatedMachine:
             alarm = self._swivel_collision(self._pos.copy(), target)
             if alarm is not None:
                 return MoveResult(self._as_dict(self._pos), False, alarm)
-        result = self._move(target, feed, rapid)
+        result = self._move(target, feed)
         if not self._sync_table():
             return result
         if self._probe_in_spindle():
-            probe = self._scenario.probe
             with self._lock:
-                centre = ball_centre(self._pos[_XYZ], probe.length, probe.eccentricity, self._spindle_angle,
-                                     self._head(self._pos))
-            if self._scene.sdf(centre) < probe.ball_diameter / 2.0:
+                hit = self._ball_in_solid(self._pos, self._spindle_angle)
+            if hit:
                 alarm = self._raise_alarm(Alarm(ALARM_PROBE_COLLISION, "Probe collision: the rotary table "
                                                 "turned the workpiece into the probe"))
                 return MoveResult(result.mcs, False, alarm)
@@ -354,24 +350,22 @@ class SimulatedMachine:
             self._scene = build_scene(self._scenario, table_angle=angle)
         return True
 
-    def _move(self, target: np.ndarray, feed: float | None, rapid: bool) -> MoveResult:
-        """Positioning with collision monitoring; caller holds the busy flag."""
+    def _move(self, target: np.ndarray, feed: float | None) -> MoveResult:
+        """Positioning with collision monitoring (rapid when feed is None); caller holds the busy flag."""
         start = self._pos.copy()
         self._check_limits(target)
         delta = target[_XYZ] - start[_XYZ]
         length = float(np.linalg.norm(delta))
         event = self._first_event(start, delta / length, length) if length > 0.0 else None
         if event is None or (event.kind == "switch" and event.s_switch > length):
-            reached, outcome = self._travel(start, target, feed, rapid)
+            reached, outcome = self._travel(start, target, feed)
             return self._move_result(reached, outcome)
         if event.kind == "switch":
-            cfg = self._scenario.machine
-            v = self._effective_feed(feed, rapid)
-            s_stop = min(event.s_switch + braking_distance(v, cfg.latency_s, cfg.decel, cfg.kv), length)
+            s_stop = min(event.s_switch + self._braking(self._effective_feed(feed)), length)
         else:
             s_stop = event.s_contact
         stop_at = start + (target - start) * (s_stop / length)
-        reached, outcome = self._travel(start, stop_at, feed, rapid)
+        reached, outcome = self._travel(start, stop_at, feed)
         if outcome != "done":
             return self._move_result(reached, outcome)
         alarm = self._raise_alarm(Alarm(ALARM_PROBE_COLLISION, event.text))
@@ -379,8 +373,7 @@ class SimulatedMachine:
             self._break_probe()
         return MoveResult(self._as_dict(reached), False, alarm)
 
-    def _travel(self, start: np.ndarray, end: np.ndarray, feed: float | None,
-                rapid: bool = False) -> tuple[np.ndarray, str]:
+    def _travel(self, start: np.ndarray, end: np.ndarray, feed: float | None) -> tuple[np.ndarray, str]:
         """Play the straight move out in scaled real time: -> (position, 'done'|'reset'|'stop')."""
         delta = end - start
         length = float(np.linalg.norm(delta[_XYZ])) or float(np.linalg.norm(delta))
@@ -400,7 +393,7 @@ class SimulatedMachine:
                 if self._stop.is_set():
                     return self._pos.copy(), "stop"
                 # duration = length / feed · 60 · time_scale (design.md §5), override read live
-                travelled += self._effective_feed(feed, rapid) / 60.0 * (now - last) / time_scale
+                travelled += self._effective_feed(feed) / 60.0 * (now - last) / time_scale
                 last = now
                 fraction = min(travelled / length, 1.0)
                 self._pos = start + fraction * delta
@@ -416,23 +409,22 @@ class SimulatedMachine:
         scenario = self._scenario
         if tool is None:
             return None
-        axes_xyz = start[_XYZ]
-        head = self._head(start)
         if tool == scenario.probe.t:
             probe = scenario.probe
-            centre = ball_centre(axes_xyz, probe.length, probe.eccentricity, angle, head)
+            centre = self._ball_centre(start, angle)
             radius = probe.ball_diameter / 2.0
             s_contact = self._scene.first_contact(centre, d, length, radius)
             if s_contact is None:
                 return None
             # already deflected and pressing deeper: the probe signal is on at once
             deflected = s_contact == 0.0 and self._scene.sdf(centre) <= radius
+            head = self._head(start)
             d_probe = d if head is None else head.T @ d          # pre-travel in the probe's own axes
             s_switch = s_contact if deflected else s_contact + pretravel_along(d_probe, probe.pretravel)
             return _Event("switch", s_contact, s_switch, "Probe collision")
         cutter = scenario.tool(tool)
         tool_axis = self._tool_axis_at(start)
-        tip = axes_xyz - cutter.length * tool_axis
+        tip = start[_XYZ] - cutter.length * tool_axis
         events = []
         tp = scenario.tool_probe
         if tp is not None:
@@ -450,6 +442,14 @@ class SimulatedMachine:
             return None
         return min(events, key=lambda e: e.s_switch)
 
+    def _ball_centre(self, position: np.ndarray, spindle_angle: float) -> np.ndarray:
+        """The true ball centre with the axes at ``position`` (physics.ball_centre, this probe and head)."""
+        probe = self._scenario.probe
+        return ball_centre(position[_XYZ], probe.length, probe.eccentricity, spindle_angle, self._head(position))
+
+    def _ball_in_solid(self, position: np.ndarray, spindle_angle: float) -> bool:
+        return self._scene.sdf(self._ball_centre(position, spindle_angle)) < self._scenario.probe.ball_diameter / 2.0
+
     def _probe_in_spindle(self) -> bool:
         return self._tool is not None and self._tool == self._scenario.probe.t
 
@@ -458,13 +458,21 @@ class SimulatedMachine:
         return self._probe_in_spindle() and deflection > self._scenario.probe.max_deflection
 
     def _break_probe(self) -> Alarm:
-        with self._lock:
-            self._probe_broken = True
         return self._raise_alarm(Alarm(ALARM_PROBE_BROKEN, "Probe broken: overtravel beyond the "
                                        "permissible deflection", resettable=False))
 
-    def _effective_feed(self, feed: float | None, rapid: bool = False) -> float:
-        if rapid or feed is None:
+    def _broken_alarm(self) -> Alarm | None:
+        """The broken-stylus alarm: the probe is broken exactly while it is in the list."""
+        return next((a for a in self._alarms if a.code == ALARM_PROBE_BROKEN and not a.resettable), None)
+
+    def _braking(self, feed_in_effect: float) -> float:
+        """Overtravel behind the switch at this feed (mm/min), measuring-math §1.3."""
+        cfg = self._scenario.machine
+        return braking_distance(feed_in_effect, cfg.latency_s, cfg.decel, cfg.kv)
+
+    def _effective_feed(self, feed: float | None) -> float:
+        """mm/min in effect: ``feed`` × override, or rapid × override (at most 100 %) when None."""
+        if feed is None:
             return self._scenario.machine.rapid * min(self._override, 100.0) / 100.0
         return feed * self._override / 100.0
 
@@ -472,9 +480,9 @@ class SimulatedMachine:
         with self._lock:
             if self._busy:
                 raise MachineBusy("a motion is already running")
-            if self._probe_broken and self._probe_in_spindle():
-                alarm = next((a for a in self._alarms if a.code == ALARM_PROBE_BROKEN and not a.resettable), None)
-                raise MachineAlarm(alarm or self._break_probe())
+            broken = self._broken_alarm()
+            if broken is not None:
+                raise MachineAlarm(broken)
             self._busy = True
             self._abort.clear()
             self._stop.clear()
@@ -565,14 +573,11 @@ class SimulatedMachine:
         sc = self._scenario
         for k in range(1, SWIVEL_SAMPLES + 1):
             pose = start + (target - start) * (k / SWIVEL_SAMPLES)
-            head = self._head(pose)
             if tool == sc.probe.t:
-                centre = ball_centre(pose[_XYZ], sc.probe.length, sc.probe.eccentricity, angle, head)
-                hit = self._scene.sdf(centre) < sc.probe.ball_diameter / 2.0
+                hit = self._ball_in_solid(pose, angle)
             else:
                 cutter = sc.tool(tool)
-                axis = head @ Z_UNIT
-                end = pose[_XYZ] - (cutter.length - cutter.radius) * axis
+                end = pose[_XYZ] - (cutter.length - cutter.radius) * self._tool_axis_at(pose)
                 hit = self._scene.subset({"part", "ring_gauge"}).sdf(end) < cutter.radius
             if hit:
                 return self._raise_alarm(Alarm(ALARM_PROBE_COLLISION, "Probe collision: the swivel "
@@ -638,8 +643,7 @@ class SimulatedMachine:
                 s_max = min(s_max, (hi - xyz[i]) / axis[i])
             elif axis[i] < -1e-12:
                 s_max = min(s_max, (lo - xyz[i]) / axis[i])
-        s = s_max if distance is None else _finite(distance, "distance")
-        s = max(0.0, min(s, s_max)) if distance is None else s
+        s = max(0.0, s_max) if distance is None else _finite(distance, "distance")
         target = xyz + s * axis
         return self.goto({a: float(v) for a, v in zip(GEOMETRY_AXES, target, strict=True)}, None)
 
@@ -647,46 +651,13 @@ class SimulatedMachine:
     def scene_geometry(self) -> dict:
         """The true scene for the machine view (JSON-ready, MCS)."""
         sc = self._scenario
-        out: dict = {"block": None, "circles": [], "rects": []}
-        wp = sc.workpiece
-        if wp is not None and wp.block is not None:
-            rot, trans = workpiece_pose(sc, self._table_angle)
-
-            def place(x: float, y: float, z: float) -> list[float]:
-                return [float(v) for v in rot @ np.array([x, y, z]) + trans]
-
-            axis = [float(v) for v in rot @ Z_UNIT]
-            lx, ly, lz = wp.block.size
-            out["block"] = {"corners": [place(x, y, z) for z in (0.0, -lz) for x, y in
-                                        ((0, 0), (lx, 0), (lx, ly), (0, ly))]}
-            for f in wp.features:
-                if f.type in ("hole", "spigot"):
-                    top = 0.0 if f.type == "hole" else f.height
-                    height = f.depth if f.type == "hole" else f.height
-                    out["circles"].append({"kind": f.type, "center": place(f.center[0], f.center[1], top),
-                                           "axis": axis, "diameter": f.diameter, "height": height})
-                elif f.type in ("pocket", "boss"):
-                    top = 0.0 if f.type == "pocket" else f.height
-                    hx, hy = f.size[0] / 2, f.size[1] / 2
-                    cx, cy = f.center
-                    out["rects"].append({"kind": f.type, "corners": [
-                        place(cx + sx * hx, cy + sy * hy, top) for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))]})
-        up = [0.0, 0.0, 1.0]
-        if sc.ring_gauge is not None:
-            ring = sc.ring_gauge
-            for kind, dia in (("ring_bore", ring.diameter), ("ring_outer", ring.outer_diameter)):
-                out["circles"].append({"kind": kind, "center": list(ring.center), "axis": up,
-                                       "diameter": dia, "height": ring.height})
-        if sc.tool_probe is not None:
-            tp = sc.tool_probe
-            out["circles"].append({"kind": "tool_probe", "center": list(tp.center), "axis": up,
-                                   "diameter": tp.disc_diameter, "height": tp.height})
+        out = outline(sc, self._table_angle)
         with self._lock:
-            axes_xyz = self._pos[_XYZ].copy()
+            position = self._pos.copy()
             tool, angle = self._tool, self._spindle_angle
-            head, tool_axis = self._head(self._pos), self._tool_axis_at(self._pos)
+        axes_xyz, tool_axis = position[_XYZ], self._tool_axis_at(position)
         if tool is not None and tool == sc.probe.t:
-            tip = ball_centre(axes_xyz, sc.probe.length, sc.probe.eccentricity, angle, head)
+            tip = self._ball_centre(position, angle)
             probe = {"tip": tip, "diameter": sc.probe.ball_diameter, "is_probe": True, "tool_radius": 0.0}
         elif tool is not None:
             cutter = sc.tool(tool)
