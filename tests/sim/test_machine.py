@@ -7,7 +7,6 @@ import numpy as np
 import pytest
 from sim_helpers import plane_contact, rotation, scenario
 
-from app.machine.physics import braking_distance
 from app.machine.protocol import (
     ALARM_LIMIT,
     ALARM_PROBE_BROKEN,
@@ -144,7 +143,10 @@ def test_collision_during_goto_stops_short_with_61302():
     target = start - 60.0 * n
     result = m.goto(dict(zip(XYZ, target, strict=True)), feed=1000.0)
     assert not result.completed and result.alarm.code == ALARM_PROBE_COLLISION
-    expected = start + (30.0 + braking_distance(1000.0, 0.0, 1.0, 1.0)) * (-n)
+    # braking behind the switch (measuring-math §1.3): v = 1000 mm/min, t = 0, a = 1 m/s², Kv = 1
+    v = 1000.0 / 60000.0                                      # m/s
+    s_b = 1000.0 * v**2 / (2 * 1.0) + 1.0 / 1.0               # 0.1389 mm + following error 1 mm
+    expected = start + (30.0 + s_b) * (-n)
     assert _xyz(result.mcs) == pytest.approx(expected, abs=1e-9)
     assert [a.code for a in m.status().alarms] == [ALARM_PROBE_COLLISION]
     m.reset()
@@ -159,14 +161,14 @@ def test_rapid_into_the_part_breaks_the_probe_until_tool_change():
     result = m.goto(dict(zip(XYZ, start - 60.0 * n, strict=True)))     # rapid
     assert result.alarm.code == ALARM_PROBE_COLLISION
     alarms = m.status().alarms
-    assert [a.resettable for a in alarms] == [True, False]       # collision, then broken stylus
-    assert all(a.code in (ALARM_PROBE_COLLISION, ALARM_PROBE_BROKEN) for a in alarms)
+    assert [(a.code, a.resettable) for a in alarms] == [(ALARM_PROBE_COLLISION, True),   # collision,
+                                                        (ALARM_PROBE_BROKEN, False)]     # broken stylus
     m.reset()
     remaining = m.status().alarms
     assert len(remaining) == 1 and remaining[0].code == ALARM_PROBE_BROKEN and not remaining[0].resettable
     with pytest.raises(MachineAlarm) as err:
         m.jog("Z", 10.0)
-    assert err.value.alarm.code == ALARM_PROBE_BROKEN
+    assert err.value.alarm.code == ALARM_PROBE_BROKEN and not err.value.alarm.resettable
     m.change_tool(9, 100.0)
     assert m.status().alarms == ()
     assert m.goto(dict(zip(XYZ, start, strict=True))).completed
@@ -176,9 +178,31 @@ def test_probe_overtravel_beyond_max_deflection_breaks():
     m, _, n = _machine_in_front(scenario())      # max_deflection 5 mm; 6000 mm/min brakes > 6 mm
     with pytest.raises(MachineAlarm) as err:
         m.probe(-n, 20.0, 6000.0)
-    assert err.value.alarm.code == ALARM_PROBE_BROKEN
-    with pytest.raises(MachineAlarm):
+    assert err.value.alarm.code == ALARM_PROBE_BROKEN and not err.value.alarm.resettable   # 61302 is also
+    m.reset()                                                                          # the collision
+    with pytest.raises(MachineAlarm) as err:
         m.probe(n, 20.0, 300.0)
+    assert not err.value.alarm.resettable
+
+
+@pytest.mark.parametrize("max_deflection, breaks", [(12.7, False), (12.5, True)])
+def test_manual_braking_example_1_3_a_on_the_machine(max_deflection, breaks):
+    # measuring-math §1.3-A: v = 6 m/min, t = 0.016 s, a = 1 m/s², Kv = 1 -> s_b = 12.6 mm behind the
+    # switch; the latch lies v·t = 1.6 mm behind it; no pre-travel, so the deflection is s_b
+    sc = scenario(machine={"latency_s": 0.016, "decel": 1.0, "kv": 1.0},
+                  probe={"max_deflection": max_deflection})
+    m, _, n = _machine_in_front(sc)                  # contact after 10 mm along -n
+    start = _xyz(m.status().mcs)
+    if breaks:
+        with pytest.raises(MachineAlarm) as err:
+            m.probe(-n, 30.0, 6000.0)
+        assert err.value.alarm.code == ALARM_PROBE_BROKEN and not err.value.alarm.resettable
+        end = _xyz(m.status().mcs)
+    else:
+        r = m.probe(-n, 30.0, 6000.0)
+        assert (_xyz(r.latched_mcs) - start) @ (-n) == pytest.approx(10.0 + 1.6, abs=1e-9)
+        end = _xyz(r.end_mcs)
+    assert end == pytest.approx(start + (10.0 + 12.6) * (-n), abs=1e-9)
 
 
 def test_limits_refuse_before_moving():
@@ -282,12 +306,16 @@ def test_cutter_touching_the_workpiece_is_a_collision():
 
 def test_load_resets_machine_and_noise_sequence():
     sc = scenario(probe={"t": 9, "ball_diameter": 4.0, "length": L, "noise_sigma": 0.001})
-    m = SimulatedMachine(sc)
+    m, _, n = _machine_in_front(sc)
+    in_front = m.status().mcs
+    first = m.probe(-n, 20.0, 300.0).latched_mcs
     m.set_override(30.0)
-    m.goto({"X": 10.0})
+    m.change_tool(1, 85.0)
     m.load(sc)
     st = m.status()
     assert st.mcs == {"X": 0.0, "Y": 0.0, "Z": 50.0} and st.feed_override == 100.0 and st.tool == 9
+    m.goto(in_front)
+    assert m.probe(-n, 20.0, 300.0).latched_mcs == first        # the seeded noise starts again
 
 
 def test_scene_geometry_is_json_ready():
@@ -315,19 +343,6 @@ def test_unknown_tool_is_alarm_61343():
     with pytest.raises(MachineAlarm) as err:
         m.change_tool(77, 10.0)
     assert err.value.alarm.code == 61343 and m.status().tool == 9
-
-
-def test_bench_one_probing_move(capsys):
-    m, _, n = _machine_in_front(scenario())
-    start = m.status().mcs
-    t0 = time.perf_counter()
-    for _ in range(50):
-        m.probe(-n, 20.0, 300.0)
-        m.goto(start)
-    per_move = (time.perf_counter() - t0) / 100
-    with capsys.disabled():
-        print(f"\n[bench] one sim move at time_scale 0: {per_move * 1e3:.2f} ms")
-    assert per_move < 0.05
 
 
 def test_reset_stops_the_spindle():

@@ -37,6 +37,8 @@ def test_demo_is_sensible():
 @pytest.mark.parametrize("bad, field", [
     ({"probe": {"ball_diameter": -4}}, "probe.ball_diameter"),
     ({"machine": {"limits": {"X": [10, -10]}}}, "limits.X"),
+    ({"machine": {"limits": {"Y": [float("-inf"), 10]}}}, "limits.Y"),
+    ({"rotary_axes": {"C": {"limits": [0, float("nan")]}}}, "rotary_axes.C.limits"),
     ({"machine": {"latency_s": "soon"}}, "machine.latency_s"),
     ({"workpiece": {"features": [{"type": "cone"}]}}, "workpiece.features.0"),
     ({"probe": {"pretravel": {"W+": 0.1}}}, "probe.pretravel"),
