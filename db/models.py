@@ -9,7 +9,7 @@ from __future__ import annotations
 from typing import Any
 
 from sqlalchemy import JSON, CheckConstraint, Float, Index, Integer, String, UniqueConstraint
-from sqlalchemy.orm import DeclarativeBase, Mapped, mapped_column
+from sqlalchemy.orm import DeclarativeBase, Mapped, declared_attr, mapped_column
 
 GEOMETRY_AXES = ("X", "Y", "Z")
 ROTARY_AXES = ("A", "B", "C")
@@ -17,6 +17,7 @@ AXES = GEOMETRY_AXES + ROTARY_AXES
 
 # Frame kinds in the order of the frame chain, outside in (spec §4.5; no global basic frames here).
 FRAME_KINDS = ("setframe", "chbasic", "settable")
+MAX_PROBE_NUMBER = 99            # probe and tool-probe records 1..99
 
 # JSON that stores Python None as SQL NULL (nullable document columns).
 NullableJSON = JSON(none_as_null=True)
@@ -81,44 +82,46 @@ class Tool(Base):
     wear_radius: Mapped[float] = mapped_column(Float, default=0.0)
 
 
-class Probe(Base):
-    """Workpiece probe record _WP[number - 1]; the document's schema belongs to the app."""
+class _ProbeRecord:
+    """Columns of a numbered probe record: a JSON document (schema owned by the app) + its number."""
+
+    number: Mapped[int] = mapped_column(Integer, primary_key=True, autoincrement=False)
+    calibrated_at: Mapped[str | None] = mapped_column(String(40))
+    data: Mapped[dict[str, Any]] = mapped_column(JSON)
+
+    @declared_attr.directive
+    def __table_args__(cls) -> tuple:
+        return (CheckConstraint(f"number BETWEEN 1 AND {MAX_PROBE_NUMBER}",
+                                name=f"ck_{cls.__tablename__}_number"),)
+
+
+class Probe(_ProbeRecord, Base):
+    """Workpiece probe record _WP[number - 1]."""
 
     __tablename__ = "probes"
-    __table_args__ = (CheckConstraint("number BETWEEN 1 AND 99", name="ck_probes_number"),)
-
-    number: Mapped[int] = mapped_column(Integer, primary_key=True, autoincrement=False)
-    calibrated_at: Mapped[str | None] = mapped_column(String(40))
-    data: Mapped[dict[str, Any]] = mapped_column(JSON)
 
 
-class ToolProbe(Base):
-    """Tool probe record _TP[number - 1]; the document's schema belongs to the app."""
+class ToolProbe(_ProbeRecord, Base):
+    """Tool probe record _TP[number - 1]."""
 
     __tablename__ = "tool_probes"
-    __table_args__ = (CheckConstraint("number BETWEEN 1 AND 99", name="ck_tool_probes_number"),)
-
-    number: Mapped[int] = mapped_column(Integer, primary_key=True, autoincrement=False)
-    calibrated_at: Mapped[str | None] = mapped_column(String(40))
-    data: Mapped[dict[str, Any]] = mapped_column(JSON)
 
 
-class Setting(Base):
+class _KeyValue:
+    key: Mapped[str] = mapped_column(String(64), primary_key=True)
+    value: Mapped[Any] = mapped_column(JSON, nullable=True)
+
+
+class Setting(_KeyValue, Base):
     """One GUD-like setting (key -> JSON value)."""
 
     __tablename__ = "settings"
 
-    key: Mapped[str] = mapped_column(String(64), primary_key=True)
-    value: Mapped[Any] = mapped_column(JSON, nullable=True)
 
-
-class MachineState(Base):
+class MachineState(_KeyValue, Base):
     """Machine state the app keeps across restarts (active offset, tool in spindle)."""
 
     __tablename__ = "machine_state"
-
-    key: Mapped[str] = mapped_column(String(64), primary_key=True)
-    value: Mapped[Any] = mapped_column(JSON, nullable=True)
 
 
 class MeasurementLog(Base):

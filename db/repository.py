@@ -20,6 +20,8 @@ from sqlalchemy.orm import Session
 from db.models import (
     AXES,
     GEOMETRY_AXES,
+    MAX_PROBE_NUMBER,
+    ROTARY_AXES,
     FrameAxis,
     MachineState,
     MeasurementLog,
@@ -32,7 +34,6 @@ from db.models import (
 
 CHANNEL = 1
 DEFAULT_PROBE_RECORDS = 3        # _CVAL[0], _CVAL[1]: 3 records each by default
-MAX_PROBE_NUMBER = 99
 MAX_EXTRA_SETTABLE = 95          # G505..G599
 LOG_FIELDS = ("task", "params", "raw", "points", "result", "correction", "probe", "target", "status")
 TOOL_FIELDS = ("t", "name", "type", "length", "radius", "wear")
@@ -71,7 +72,7 @@ def identity_frame(rotary_axes: Iterable[str] = ()) -> dict:
 def seed_defaults(session: Session, layout: Iterable[OffsetSlot], rotary_axes: Iterable[str]) -> None:
     """Adds what is missing (identity frames, empty probe records); never changes stored data."""
     rotary_axes = tuple(rotary_axes)
-    unknown = set(rotary_axes) - set(AXES[3:])
+    unknown = set(rotary_axes) - set(ROTARY_AXES)
     if unknown:
         raise ValueError(f"unknown rotary axes {sorted(unknown)}")
     present = set(session.execute(select(FrameAxis.name, FrameAxis.axis).where(FrameAxis.channel == CHANNEL)))
