@@ -7,15 +7,15 @@ tasks use: the record bound to the tool in the spindle, else _JM_I[1]."""
 
 from __future__ import annotations
 
+from functools import partial
+
 from fastapi import APIRouter, Request
-from pydantic import ValidationError
 
 from app.deps import MachineDep, ProbesDep, SettingsDep
-from app.errors import HmiError
 from app.services.measuring import probe_number_for
-from app.services.probes import MAX_PROBE, ProbeData
-from app.services.settings import validation_errors
 
+from . import probe_records
+from .probe_records import number
 from .templating import render_screen
 
 router = APIRouter()
@@ -26,37 +26,28 @@ TRIGGERS = [("X-", 1, "travel −X (abscissa minus)"), ("X+", 2, "travel +X (abs
             ("Z-", 5, "travel −Z (infeed minus)")]
 
 
-def _number(text, name: str, errors: dict) -> float | None:
-    text = str(text or "").strip().replace(",", ".")
-    if text == "":
-        return None
-    try:
-        return float(text)
-    except ValueError:
-        errors[name] = f"{text!r} is not a number"
-        return None
-
-
 def parse_form(form, stored: dict) -> tuple[dict, dict[str, str]]:
     """Form -> record (the stored record with the edited fields), {field: error}."""
     errors: dict[str, str] = {}
+    old = stored.get("trigger") or {}
     edited = {key for key, _index, _text in TRIGGERS}
-    trigger = {k: v for k, v in (stored.get("trigger") or {}).items() if k not in edited}
+    trigger = {k: v for k, v in old.items() if k not in edited}
     for key, _index, _text in TRIGGERS:
-        value = _number(form.get(f"trigger.{key}", ""), f"trigger.{key}", errors)
+        value = number(form.get(f"trigger.{key}", ""), f"trigger.{key}", errors, old.get(key))
         if value is not None:
             trigger[key] = value
     record = {**stored, "trigger": trigger}
     for name in ("ball_diameter", "effective_diameter"):
-        value = _number(form.get(name, ""), name, errors)
+        value = number(form.get(name, ""), name, errors, stored.get(name))
         if name not in errors:
             if value is None and name == "ball_diameter":
                 errors[name] = "required"
             record[name] = 0.0 if value is None else value
     skew = []
     for i, axis in enumerate("XY"):
-        value = _number(form.get(f"skew.{axis}", ""), f"skew.{axis}", errors)
-        skew.append((stored.get("skew") or [0.0, 0.0])[i] if value is None else value)
+        old = (stored.get("skew") or [0.0, 0.0])[i]
+        value = number(form.get(f"skew.{axis}", ""), f"skew.{axis}", errors, old)
+        skew.append(old if value is None else value)
     record["skew"] = skew
     tool_text = str(form.get("tool", "")).strip()
     if tool_text == "":
@@ -85,58 +76,20 @@ def _screen(request: Request, probes, settings, machine, n: int | None = None, r
     active = probe_number_for(records, spindle, int(settings.get().probe_number))
     n = active if n is None else n
     if record is None:
-        record = next((r for r in records if r["number"] == n), None) \
-            or ProbeData(number=n).model_dump(mode="json")
-    numbers = sorted({r["number"] for r in records} | {active, n})
+        record = probe_records.stored_or_new(probes, n)
     return render_screen(request, "probes.html", {
-        "screen": "probes", "n": n, "active": active, "spindle": spindle, "numbers": numbers,
+        "screen": "probes", "n": n, "active": active, "spindle": spindle,
         "records": records, "record": record, "triggers": TRIGGERS, "errors": errors or {},
         "texts": texts or {}, "message": message, "level": level,
         "length_to_tip_gud": bool(settings.get().length_to_tip)})
 
 
-def _record_number(text) -> int | None:
-    try:
-        n = int(text)
-    except (TypeError, ValueError):
-        return None
-    return n if 1 <= n <= MAX_PROBE else None
-
-
 @router.get("/probes")
 def probes_screen(request: Request, probes: ProbesDep, settings: SettingsDep, machine: MachineDep):
-    if "n" in request.query_params:
-        n = _record_number(request.query_params.get("n"))
-        if n is None:
-            return _screen(request, probes, settings, machine, level="error",
-                           message=f"n: probe number must be 1..{MAX_PROBE}")
-        return _screen(request, probes, settings, machine, n)
-    return _screen(request, probes, settings, machine)
+    return probe_records.show(request, probes, partial(_screen, request, probes, settings, machine))
 
 
 @router.post("/probes/{n}")
 async def save_probe(request: Request, n: int, probes: ProbesDep, settings: SettingsDep, machine: MachineDep):
-    if _record_number(n) is None:
-        return _screen(request, probes, settings, machine, level="error",
-                       message=f"n: probe number must be 1..{MAX_PROBE}")
-    form = await request.form()
-    try:
-        stored = probes.get(n)
-    except HmiError:
-        stored = ProbeData(number=n).model_dump(mode="json")
-    record, errors = parse_form(form, stored)
-    if not errors:
-        try:
-            ProbeData.model_validate(record)
-        except ValidationError as exc:
-            errors = validation_errors(exc)
-    texts = {k: str(v) for k, v in form.items()}
-    if errors:
-        return _screen(request, probes, settings, machine, n, record=record, errors=errors, texts=texts,
-                       level="error", message=f"Not saved: {len(errors)} field(s) need correction")
-    try:
-        saved = probes.put(n, record)
-    except HmiError as exc:
-        return _screen(request, probes, settings, machine, n, record=record, texts=texts, level="error",
-                       errors={exc.field or "form": exc.message}, message=exc.message)
-    return _screen(request, probes, settings, machine, n, record=saved, message=f"Probe {n} saved")
+    return await probe_records.save(request, probes, n, parse_form,
+                                    partial(_screen, request, probes, settings, machine))

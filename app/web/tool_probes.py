@@ -5,14 +5,15 @@ calibration itself is the ``Measure tool > Calibrate probe`` screen."""
 
 from __future__ import annotations
 
+from functools import partial
+
 from fastapi import APIRouter, Request
-from pydantic import ValidationError
 
 from app.deps import SettingsDep, ToolProbesDep
-from app.errors import HmiError
-from app.services.probes import MAX_PROBE, ToolProbeData
-from app.services.settings import validation_errors
+from engine.toolmeasure import probe_centre
 
+from . import probe_records
+from .probe_records import number
 from .templating import render_screen
 
 router = APIRouter()
@@ -23,25 +24,6 @@ TRIGGERS = [("X-", 0, "travel −X: the probe's +X face"), ("X+", 1, "travel +X:
             ("Z-", 4, "travel −Z: the probe's upper face")]
 TYPES = [(0, "0 cube"), (101, "101 disc in XY"), (201, "201 disc in ZX"), (301, "301 disc in YZ")]
 NUMBERS = ("disc_diameter", "dz")
-
-
-def shown(value) -> str:
-    """How the screen shows a stored mm value (the template's '%.4f')."""
-    return "" if value is None else f"{float(value):.4f}"
-
-
-def _number(text: str, name: str, errors: dict, stored=None) -> float | None:
-    """Typed text -> mm; the untouched display text of ``stored`` keeps its full precision."""
-    text = (text or "").strip().replace(",", ".")
-    if text == "":
-        return None
-    if stored is not None and text == shown(stored):
-        return float(stored)
-    try:
-        return float(text)
-    except ValueError:
-        errors[name] = f"{text!r} is not a number"
-        return None
 
 
 def check_axes(code: int) -> str | None:
@@ -59,13 +41,13 @@ def parse_form(form, stored: dict) -> tuple[dict, dict[str, str]]:
     errors: dict[str, str] = {}
     trigger: dict[str, float] = {}
     for key, _index, _text in TRIGGERS:
-        value = _number(form.get(f"trigger.{key}", ""), f"trigger.{key}", errors,
-                        (stored.get("trigger") or {}).get(key))
+        value = number(form.get(f"trigger.{key}", ""), f"trigger.{key}", errors,
+                       (stored.get("trigger") or {}).get(key))
         if value is not None:
             trigger[key] = value
     record = {**stored, "trigger": trigger}
     for name in NUMBERS:
-        value = _number(form.get(name, ""), name, errors, stored.get(name))
+        value = number(form.get(name, ""), name, errors, stored.get(name))
         if name not in errors:
             record[name] = 0.0 if value is None and name == "disc_diameter" else value
             if record[name] is None:
@@ -89,10 +71,10 @@ def parse_form(form, stored: dict) -> tuple[dict, dict[str, str]]:
 
 
 def _view(record: dict) -> dict:
+    """Probe centre (engine) and width per plane axis with both trigger values known."""
     trig = record.get("trigger") or {}
-    centre = {a: (trig[f"{a}-"] + trig[f"{a}+"]) / 2.0 for a in "XY" if f"{a}-" in trig and f"{a}+" in trig}
-    width = {a: trig[f"{a}-"] - trig[f"{a}+"] for a in centre}
-    return {"centre": centre, "width": width}
+    centre = {a: c for a, c in probe_centre(trig).items() if a in "XY"}
+    return {"centre": centre, "width": {a: trig[f"{a}-"] - trig[f"{a}+"] for a in centre}}
 
 
 def _screen(request: Request, tool_probes, settings, n: int | None = None, record: dict | None = None,
@@ -102,56 +84,19 @@ def _screen(request: Request, tool_probes, settings, n: int | None = None, recor
     n = active if n is None else n
     numbers = sorted({r["number"] for r in tool_probes.list()} | {active, n})
     if record is None:
-        try:
-            record = tool_probes.get(n)
-        except HmiError:
-            record = {**ToolProbeData(number=n).model_dump(mode="json")}
+        record = probe_records.stored_or_new(tool_probes, n)
     return render_screen(request, "tool_probes.html", {
         "screen": "tool_probes", "n": n, "active": active, "numbers": numbers, "record": record,
         "triggers": TRIGGERS, "types": TYPES, "errors": errors or {}, "texts": texts or {},
         "message": message, "level": level, "view": _view(record)})
 
 
-def _record_number(text) -> int | None:
-    try:
-        n = int(text)
-    except (TypeError, ValueError):
-        return None
-    return n if 1 <= n <= MAX_PROBE else None
-
-
 @router.get("/tool-probes")
 def tool_probes_screen(request: Request, tool_probes: ToolProbesDep, settings: SettingsDep):
-    n = _record_number(request.query_params.get("n")) if "n" in request.query_params else None
-    if "n" in request.query_params and n is None:
-        return _screen(request, tool_probes, settings, message=f"n: tool probe number must be 1..{MAX_PROBE}",
-                       level="error")
-    return _screen(request, tool_probes, settings, n)
+    return probe_records.show(request, tool_probes, partial(_screen, request, tool_probes, settings))
 
 
 @router.post("/tool-probes/{n}")
 async def save_tool_probe(request: Request, n: int, tool_probes: ToolProbesDep, settings: SettingsDep):
-    if _record_number(n) is None:
-        return _screen(request, tool_probes, settings, message=f"n: tool probe number must be 1..{MAX_PROBE}",
-                       level="error")
-    form = await request.form()
-    try:
-        stored = tool_probes.get(n)
-    except HmiError:
-        stored = ToolProbeData(number=n).model_dump(mode="json")
-    record, errors = parse_form(form, stored)
-    if not errors:
-        try:
-            ToolProbeData.model_validate(record)
-        except ValidationError as exc:
-            errors = validation_errors(exc)
-    texts = {k: str(v) for k, v in form.items()}
-    if errors:
-        return _screen(request, tool_probes, settings, n, record=record, errors=errors, texts=texts, level="error",
-                       message=f"Not saved: {len(errors)} field(s) need correction")
-    try:
-        saved = tool_probes.put(n, record)
-    except HmiError as exc:
-        return _screen(request, tool_probes, settings, n, record=record, errors={exc.field or "form": exc.message},
-                       texts=texts, message=exc.message, level="error")
-    return _screen(request, tool_probes, settings, n, record=saved, message=f"Tool probe {n} saved")
+    return await probe_records.save(request, tool_probes, n, parse_form,
+                                    partial(_screen, request, tool_probes, settings))

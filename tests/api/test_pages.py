@@ -120,3 +120,20 @@ def test_machine_view_draws_the_scene_and_the_probe(client):
     text = client.get("/machine-view/views", headers=HTMX).text
     assert 'id="view-top"' in text and 'id="view-front"' in text
     assert 'class="block"' in text and 'id="probe-top"' in text and 'class="ring_outer"' in text
+
+
+@pytest.mark.parametrize("screen, api", [("/probes", "/api/probes"), ("/tool-probes", "/api/tool-probes")])
+def test_probe_record_saved_untouched_keeps_every_stored_digit(client, screen, api):
+    """The screens show 4 decimals; saving the form as shown must not round the stored record."""
+    trigger = {"X-": 1.98765432, "X+": -2.01234567, "Y-": 2.0, "Y+": -2.0}
+    client.put(f"{api}/2", json={"trigger": trigger})
+    record = client.get(f"{api}/2").json()
+    form = {f"trigger.{k}": f"{v:.4f}" for k, v in record["trigger"].items()}
+    if screen == "/probes":
+        form.update({"ball_diameter": f"{record['ball_diameter']:.4f}", "tool": ""})
+    else:
+        form.update({"disc_diameter": f"{record['disc_diameter']:.4f}", "dz": f"{record['dz']:.4f}",
+                     "type": str(record["type"]), "axes": str(record["axes"])})
+    page = client.post(f"{screen}/2", data=form, headers=HTMX)
+    assert "2 saved" in page.text, page.text
+    assert client.get(f"{api}/2").json()["trigger"] == trigger
