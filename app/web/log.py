@@ -11,17 +11,13 @@ from fastapi.responses import Response
 
 from app.deps import LogDep
 
-from .templating import render_screen
+from .task_screens import correction_rows
+from .templating import fmt_result, render_screen
 
 router = APIRouter()
 LIMIT = 500
-ANGLE_KEYS = {"angle", "alpha", "beta", "angle_2", "corner_angle"}
 MAIN_KEYS = ("position", "corner", "center", "distance", "diameter", "length", "width", "radius", "angle",
              "alpha", "beta", "p1")
-
-
-def _num(key: str, value) -> str:
-    return f"{value:.4f}" if key in ANGLE_KEYS else f"{value:.3f}"
 
 
 def main_result(result: dict | None) -> str:
@@ -30,27 +26,21 @@ def main_result(result: dict | None) -> str:
     for key in MAIN_KEYS:
         value = (result or {}).get(key)
         if isinstance(value, dict):
-            parts.append(f"{key} " + " ".join(f"{a}={_num(key, v)}" for a, v in value.items()
+            parts.append(f"{key} " + " ".join(f"{a}={fmt_result(key, v)}" for a, v in value.items()
                                               if isinstance(v, int | float)))
         elif isinstance(value, int | float) and not isinstance(value, bool):
-            parts.append(f"{key}={_num(key, value)}")
+            parts.append(f"{key}={fmt_result(key, value)}")
     if not parts and isinstance((result or {}).get("probe"), dict):
         parts.append("probe data")
     return "; ".join(parts)
 
 
 def correction_text(correction: dict | None) -> str:
-    """Changed components of the target WO: 'G54 trans.X 10.000→12.345'."""
+    """Changed components of the target WO: 'G54: trans.X 10.000→12.345'."""
     if not correction or not correction.get("after"):
         return "measure only" if correction and correction.get("target") == "measure_only" else ""
-    before, after = correction.get("before") or {}, correction["after"]
-    changes = []
-    for part in ("trans", "fine", "rot"):
-        for axis, new in (after.get(part) or {}).items():
-            old = (before.get(part) or {}).get(axis, 0.0)
-            if abs(float(new) - float(old)) > 1e-9:
-                key = "angle" if part == "rot" else part
-                changes.append(f"{part}.{axis} {_num(key, old)}→{_num(key, new)}")
+    changes = [f"{row['field']} {row['before']}→{row['after']}" for row in correction_rows(correction)
+               if row["changed"]]
     return f"{correction.get('target')}: " + (", ".join(changes) if changes else "unchanged")
 
 

@@ -1,8 +1,8 @@
 """Measure workpiece / Measure tool softkey menus (spec/jog-measuring.md §2.2) and input-screen slots.
 
-The menu tree is data. An input screen is plugged in by registering a handler for its task id:
-``INPUT_SCREENS["edge.set"] = handler`` with ``handler(request) -> Response``; until then the
-route shows a placeholder naming the task.
+The menu tree is data. The input screen of a leaf is the handler registered for its task id by
+``app/web/task_screens.py``: ``INPUT_SCREENS["edge.set"] = handler`` with
+``handler(request) -> Response`` (a registry, as that module builds on this one's menu tree).
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 from fastapi import APIRouter, HTTPException, Request
 
-from .templating import render_screen
+from .templating import render_screen, vkeys
 
 router = APIRouter()
 
@@ -31,6 +31,12 @@ class Menu:
     items: tuple = field(default_factory=tuple)
 
 
+def _circles(noun: str, family: str) -> tuple[Leaf, ...]:
+    """The "1 hole" .. "4 holes" (or circular spigots) leaves: slug ``hole1``, task ``hole.1``."""
+    return tuple(Leaf(f"{k} {noun}{'s' if k > 1 else ''}", f"{family}{k}", f"{family}.{k}")
+                 for k in range(1, 5))
+
+
 WORKPIECE_MENU = Menu("Measure workpiece", "workpiece", (
     Menu("Measure edge", "edge", (
         Leaf("Set edge", "set", "edge.set"),
@@ -43,17 +49,11 @@ WORKPIECE_MENU = Menu("Measure workpiece", "workpiece", (
     )),
     Menu("Measure pocket/hole", "pocket", (
         Leaf("Rectangular pocket", "rect", "pocket.rect"),
-        Leaf("1 hole", "hole1", "hole.1"),
-        Leaf("2 holes", "hole2", "hole.2"),
-        Leaf("3 holes", "hole3", "hole.3"),
-        Leaf("4 holes", "hole4", "hole.4"),
+        *_circles("hole", "hole"),
     )),
     Menu("Measure spigot", "spigot", (
         Leaf("Rectangular spigot", "rect", "spigot.rect"),
-        Leaf("1 circular spigot", "spigot1", "spigot.1"),
-        Leaf("2 circular spigots", "spigot2", "spigot.2"),
-        Leaf("3 circular spigots", "spigot3", "spigot.3"),
-        Leaf("4 circular spigots", "spigot4", "spigot.4"),
+        *_circles("circular spigot", "spigot"),
     )),
     Leaf("Orient plane", "plane", "plane.align"),
     Menu("Calibrate probe", "calibrate", (
@@ -71,7 +71,7 @@ TOOL_MENU = Menu("Measure tool", "tool", (
 # the guided "tilted workpiece set-up" (app/web/tilted_setup.py): an extra softkey of the menu
 TILTED_SETUP_KEY = {"label": "Tilted set-up >", "href": "/measure/workpiece/tilted-setup"}
 
-# task id -> handler(request) rendering its input screen (filled in by the measuring workflow)
+# task id -> handler(request) rendering its input screen (filled in by app/web/task_screens.py)
 INPUT_SCREENS: dict[str, Callable[[Request], object]] = {}
 
 
@@ -81,9 +81,7 @@ def softkeys(menu: Menu, base: str, back: tuple[str, str]) -> list[dict]:
     for item in menu.items:
         is_menu = isinstance(item, Menu) or base.startswith("/measure/tool")
         keys.append({"label": item.label + (" >" if is_menu else ""), "href": f"{base}/{item.slug}"})
-    keys += [None] * (7 - len(keys))
-    keys.append({"label": back[0], "href": back[1]})
-    return keys
+    return vkeys(keys, {"label": back[0], "href": back[1]})
 
 
 def _find(menu: Menu, slug: str):
@@ -100,14 +98,8 @@ def _menu_screen(request: Request, menu: Menu, path: list[str], base: str, back:
         "menu": menu, "path": path, "vkeys": keys})
 
 
-def _leaf_screen(request: Request, leaf: Leaf, path: list[str], back: tuple[str, str]):
-    handler = INPUT_SCREENS.get(leaf.task)
-    if handler is not None:
-        return handler(request)
-    keys: list = [None] * 7 + [{"label": back[0], "href": back[1]}]
-    return render_screen(request, "measure_placeholder.html", {
-        "screen": "measure_tool" if leaf.task.startswith(("tool.", "toolprobe.")) else "measure_workpiece",
-        "leaf": leaf, "path": path, "vkeys": keys})
+def _leaf_screen(request: Request, leaf: Leaf):
+    return INPUT_SCREENS[leaf.task](request)
 
 
 @router.get("/measure/workpiece")
@@ -121,10 +113,10 @@ def workpiece_group(request: Request, group: str):
     item = _find(WORKPIECE_MENU, group)
     if item is None:
         raise HTTPException(404, f"no menu {group!r}")
-    path = [WORKPIECE_MENU.label, item.label]
     if isinstance(item, Leaf):
-        return _leaf_screen(request, item, path, ("Back", "/measure/workpiece"))
-    return _menu_screen(request, item, path, f"/measure/workpiece/{group}", ("Back", "/measure/workpiece"))
+        return _leaf_screen(request, item)
+    return _menu_screen(request, item, [WORKPIECE_MENU.label, item.label], f"/measure/workpiece/{group}",
+                        ("Back", "/measure/workpiece"))
 
 
 @router.get("/measure/workpiece/{group}/{task}")
@@ -133,8 +125,7 @@ def workpiece_task(request: Request, group: str, task: str):
     leaf = _find(menu, task) if isinstance(menu, Menu) else None
     if leaf is None:
         raise HTTPException(404, f"no measuring function {group}/{task}")
-    return _leaf_screen(request, leaf, [WORKPIECE_MENU.label, menu.label, leaf.label],
-                        ("Back", f"/measure/workpiece/{group}"))
+    return _leaf_screen(request, leaf)
 
 
 @router.get("/measure/tool")
@@ -147,4 +138,4 @@ def tool_task(request: Request, task: str):
     leaf = _find(TOOL_MENU, task)
     if leaf is None:
         raise HTTPException(404, f"no tool measuring function {task!r}")
-    return _leaf_screen(request, leaf, [TOOL_MENU.label, leaf.label], ("<< Back", "/measure/tool"))
+    return _leaf_screen(request, leaf)

@@ -14,8 +14,8 @@ from fastapi.responses import Response
 from app.workflow import setup_support as support
 from app.workflow.service import WorkflowError
 
-from .measure import TOOL_MENU, WORKPIECE_MENU, Leaf, Menu
-from .templating import render_screen
+from .task_screens import PAGES
+from .templating import is_htmx, render_screen, vkeys
 
 router = APIRouter()
 TOGGLE_NAMES = ("activate", "realign", "retract", "position_rotary")
@@ -23,17 +23,8 @@ TOGGLE_NAMES = ("activate", "realign", "retract", "position_rotary")
 
 def task_href(task: str) -> tuple[str, str]:
     """(label, URL) of the input screen of ``task`` in the softkey tree."""
-    def walk(menu: Menu, base: str):
-        for item in menu.items:
-            if isinstance(item, Leaf) and item.task == task:
-                return item.label, f"{base}/{item.slug}"
-            if isinstance(item, Menu):
-                found = walk(item, f"{base}/{item.slug}")
-                if found:
-                    return found
-        return None
-    return walk(WORKPIECE_MENU, "/measure/workpiece") or walk(TOOL_MENU, "/measure/tool") \
-        or (task, "/measure/workpiece")
+    page = PAGES.get(task)
+    return (page.label, page.url) if page is not None else (task, "/measure/workpiece")
 
 
 def choices_from(form) -> support.Choices:
@@ -42,19 +33,18 @@ def choices_from(form) -> support.Choices:
 
 
 def _render(request: Request, session_id: str, choices: support.Choices | None = None,
-            notice: str = "", outcome: dict | None = None, status_code: int = 200):
+            notice: str = ""):
     services = request.app.state.services
     model = support.screen_model(services.workflow, services.machine, session_id)
     if choices is not None:
         for t in model["toggles"]:
             t["value"] = bool(getattr(choices, t["name"])) and t.get("enabled", True)
         model["top_line"] = support.top_line({"reasons": model["reasons"]}, choices, model["swivel"])
-    label, href = task_href(model["task"])
-    keys: list = [None] * 7 + [{"label": "<<", "post": f"/measure/setup-support/{session_id}/leave"}]
     return render_screen(request, "setup_support.html", {
-        "screen": "measure_workpiece", "m": model, "task_label": label, "task_href": href,
-        "session_id": session_id, "notice": notice, "outcome": outcome, "vkeys": keys,
-        "message": notice or model["message"]}, status_code=status_code)
+        "screen": "measure_workpiece", "m": model, "task_label": task_href(model["task"])[0],
+        "session_id": session_id, "notice": notice,
+        "vkeys": vkeys([], {"label": "<<", "post": f"/measure/setup-support/{session_id}/leave"}),
+        "message": notice or model["message"]})
 
 
 @router.get("/measure/setup-support/{session_id}")
@@ -76,7 +66,7 @@ async def nc_start(request: Request, session_id: str):
     try:
         outcome = support.carry_out(services.workflow, services.machine, session_id, choices, db=services.db)
     except WorkflowError as exc:
-        return _render(request, session_id, choices, notice=exc.message, status_code=200)
+        return _render(request, session_id, choices, notice=exc.message)
     return _back(request, session_id, outcome)
 
 
@@ -100,6 +90,6 @@ def _back(request: Request, session_id: str, outcome: dict) -> Response:
         task = ""
     _label, href = task_href(task)
     text = " | ".join(outcome.get("messages", [])).encode("ascii", "replace").decode("ascii")
-    if request.headers.get("HX-Request") == "true":
+    if is_htmx(request):
         return Response(status_code=204, headers={"HX-Location": href, "X-HMI-Message": text[:300]})
     return Response(status_code=303, headers={"Location": href})

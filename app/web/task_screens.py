@@ -10,10 +10,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import jinja2_fragments
 import numpy as np
 from fastapi import APIRouter, HTTPException, Request
-from fastapi.responses import HTMLResponse
 from starlette.concurrency import run_in_threadpool
 
 from app.services.measuring import MeasuringEnv
@@ -33,11 +31,10 @@ from .task_forms import (
     values_from_params,
 )
 from .task_svg import draw
-from .templating import base_context, fixed, is_htmx, render_screen, templates
+from .templating import ANGLE_KEYS, fmt_result, is_htmx, render_block, render_blocks, render_screen
 
 router = APIRouter()
 TEMPLATE = "measure_task.html"
-ANGLE_KEYS = {"angle", "alpha", "beta", "angle_2", "corner_angle", "setpoint_angle"}
 
 
 @dataclass(frozen=True)
@@ -108,15 +105,22 @@ def _locked_values(fields: list[FieldSpec], session) -> dict[str, str]:
     return values_from_params(locked, session.params) if _stored_any(session) else {}
 
 
+def _typed(env: _Env, task: str, form: dict | None):
+    """(fields, the task's session, FormData): the typed text, the locked fields from the session."""
+    fields = fields_for(task, env.form_env)
+    session = env.session_of(task)
+    typed = {**(form or {}), **_locked_values(fields, session)}
+    return fields, session, form_data(task, fields, typed, env.gud)
+
+
+def _visible_answer(session):
+    """The last answer while no new point is stored (the result stays on the screen)."""
+    if session is not None and session.last and not _stored_any(session):
+        return session.last
+    return None
+
+
 # --- rendering -----------------------------------------------------------------------------
-
-def _fmt(key: str, value) -> str:
-    if isinstance(value, bool):
-        return "yes" if value else "no"
-    if isinstance(value, int | float):
-        return fixed(value, 4 if key in ANGLE_KEYS else 3)
-    return str(value)
-
 
 RESULT_LABELS = [
     ("position", "Edge position"), ("corner", "Corner P0"), ("center", "Centre P0"), ("p1", "P1"),
@@ -142,9 +146,9 @@ def result_rows(task: str, result: dict | None) -> list[tuple[str, str, str]]:
         if key == "center" and task.startswith(("hole.3", "hole.4", "spigot.3", "spigot.4")):
             label = "P0 (circle centre)" if task.endswith("3") else "P0 (diagonals)"
         if isinstance(value, dict):
-            rows += [(f"{label} {axis}", _fmt(key, v), unit) for axis, v in value.items()]
+            rows += [(f"{label} {axis}", fmt_result(key, v), unit) for axis, v in value.items()]
         elif isinstance(value, int | float):
-            rows.append((label, _fmt(key, value), unit))
+            rows.append((label, fmt_result(key, value), unit))
     for key in ("probe", "tool_probe", "tool"):
         data = result.get(key)
         if isinstance(data, dict):
@@ -158,9 +162,9 @@ def _flat(prefix: str, data: dict) -> list[tuple[str, str, str]]:
         if isinstance(value, dict):
             rows += _flat(f"{prefix} {key}", value)
         elif isinstance(value, list | tuple) and all(isinstance(v, int | float) for v in value):
-            rows.append((f"{prefix} {key}", " / ".join(_fmt(key, v) for v in value), ""))
+            rows.append((f"{prefix} {key}", " / ".join(fmt_result(key, v) for v in value), ""))
         elif isinstance(value, int | float | bool):
-            rows.append((f"{prefix} {key}", _fmt(key, value), ""))
+            rows.append((f"{prefix} {key}", fmt_result(key, value), ""))
     return rows
 
 
@@ -176,7 +180,8 @@ def correction_rows(correction: dict | None) -> list[dict]:
             if part == "fine" and not old and not new:
                 continue
             key = "angle" if part == "rot" else "trans"
-            rows.append({"label": f"{label} {axis}", "before": _fmt(key, old), "after": _fmt(key, new),
+            rows.append({"label": f"{label} {axis}", "field": f"{part}.{axis}",
+                         "before": fmt_result(key, old), "after": fmt_result(key, new),
                          "changed": abs(float(new) - float(old)) > 1e-9})
     return rows
 
@@ -208,15 +213,11 @@ def _svgs(env: _Env, task: str, params: dict | None, session, answer: dict | Non
 def _screen_context(env: _Env, page: TaskPage, form: dict | None, *, answer=None, alarm=None, errors=None,
                     notice: str = "") -> dict:
     task = page.task
-    fields = fields_for(task, env.form_env)
-    session = env.session_of(task)
-    form = dict(form or {})
-    form.update(_locked_values(fields, session))
-    data = form_data(task, fields, form, env.gud)
+    fields, session, data = _typed(env, task, form)
     stored_any = _stored_any(session)
     n_points = planning.TASK_POINTS[task]
-    if answer is None and session is not None and session.last and not stored_any:
-        answer = session.last
+    if answer is None:
+        answer = _visible_answer(session)
     if answer is not None and "result" not in answer:
         answer = None
     setup = (answer or {}).get("setup_support")
@@ -258,12 +259,8 @@ def _render(request: Request, ctx: dict, message: str = "", level: str = "info",
     """Full page on a normal GET; on htmx the screen + softkeys + message line."""
     if not is_htmx(request):
         return render_screen(request, TEMPLATE, ctx, status_code=status_code)
-    full = {"request": request, **base_context(request), **ctx, "message": message, "level": level}
-    html = "".join(jinja2_fragments.render_block(templates.env, TEMPLATE, block, full)
-                   for block in ("screen", "vsoftkeys"))
-    html += "".join(jinja2_fragments.render_block(templates.env, "base.html", block, full)
-                    for block in ("hsoftkeys", "message"))
-    return HTMLResponse(html, status_code=status_code)
+    return render_blocks(request, TEMPLATE, ["screen", "vsoftkeys", "hsoftkeys", "message"],
+                         {**ctx, "message": message, "level": level}, status_code)
 
 
 def input_screen(task: str):
@@ -300,10 +297,7 @@ def _error_view(env: _Env, page: TaskPage, form: dict, exc: WorkflowError):
 
 def _apply_form(env: _Env, page: TaskPage, form: dict):
     """The session for the typed params: recreated while no point is stored, else updated."""
-    fields = fields_for(page.task, env.form_env)
-    session = env.session_of(page.task)
-    form = {**form, **_locked_values(fields, session)}
-    data = form_data(page.task, fields, form, env.gud)
+    _fields, session, data = _typed(env, page.task, form)
     if _stored_any(session) and not session.running:
         return env.workflow.update_params(session.id, data.params, data.target)
     return env.workflow.create(page.task, data.params, data.target)
@@ -386,9 +380,7 @@ async def check_field(request: Request, task: str, name: str):
 
     def run():
         env = _Env(request)
-        fields = fields_for(task, env.form_env)
-        session = env.session_of(task)
-        data = form_data(task, fields, {**form, **_locked_values(fields, session)}, env.gud)
+        fields, session, data = _typed(env, task, form)
         error = None
         try:
             planning.validate_params(task, data.params, env.form_env.plane)
@@ -398,20 +390,11 @@ async def check_field(request: Request, task: str, name: str):
             field = field_of_error(fields, getattr(exc, "field", None))
             if field == name:
                 error = friendly(fields, field, getattr(exc, "message", str(exc)))
-        full = {"request": request, **base_context(request), "field_id": name.replace(".", "-"),
-                "field_error": error, "task": task, "oob": True,
-                "svgs": _svgs(env, task, data.params, session, _visible_answer(session))}
-        html = jinja2_fragments.render_block(templates.env, TEMPLATE, "field_error", full)
-        html += jinja2_fragments.render_block(templates.env, TEMPLATE, "svg", full)
-        return HTMLResponse(html)
+        return render_blocks(request, TEMPLATE, ["field_error", "svg"], {
+            "field_id": name.replace(".", "-"), "field_error": error, "task": task, "oob": True,
+            "svgs": _svgs(env, task, data.params, session, _visible_answer(session))})
 
     return await run_in_threadpool(run)
-
-
-def _visible_answer(session):
-    if session is not None and session.last and not _stored_any(session):
-        return session.last
-    return None
 
 
 @router.post("/measure/task/{task}/svg")
@@ -422,12 +405,9 @@ async def svg(request: Request, task: str):
 
     def run():
         env = _Env(request)
-        fields = fields_for(task, env.form_env)
-        session = env.session_of(task)
-        data = form_data(task, fields, {**form, **_locked_values(fields, session)}, env.gud)
-        full = {"request": request, **base_context(request), "task": task,
-                "svgs": _svgs(env, task, data.params, session, _visible_answer(session))}
-        return HTMLResponse(jinja2_fragments.render_block(templates.env, TEMPLATE, "svg", full))
+        _fields, session, data = _typed(env, task, form)
+        return render_block(request, TEMPLATE, "svg", {
+            "task": task, "svgs": _svgs(env, task, data.params, session, _visible_answer(session))})
 
     return await run_in_threadpool(run)
 

@@ -16,6 +16,8 @@ from markupsafe import Markup, escape
 from engine.planes import Plane
 from engine.types import MoveStep, ProbeStep
 
+from .templating import fixed
+
 AXES = ("X", "Y", "Z")
 
 
@@ -229,7 +231,7 @@ def _result(view: View, task: str, r: dict, plane: Plane) -> None:
             # trace of the measured plane: a line through the outermost touches along the 1st axis
             ends = sorted((view.uv(p) for p in pts3), key=lambda q: q[0])
             view.line(_extend(ends[0], ends[-1], -0.1), _extend(ends[0], ends[-1], 1.1), "result-line")
-        view.caption = f"α {float(r['alpha']):.4f}°  β {float(r['beta']):.4f}°"
+        view.caption = f"α {fixed(r['alpha'], 4)}°  β {fixed(r['beta'], 4)}°"
 
 
 def _extend(a, b, t: float) -> tuple[float, float]:

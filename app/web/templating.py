@@ -50,6 +50,24 @@ def fixed(value, decimals: int = 4) -> str:
     return text[1:] if text.startswith("-") and float(text) == 0.0 else text
 
 
+def vkeys(keys: list, back: dict) -> list:
+    """Vertical softkeys S-F1.. with ``back`` on S-F8 (the way out of a screen); None = an empty key."""
+    return [*keys, *[None] * (7 - len(keys)), back]
+
+
+# result keys in degrees (4 decimals); the others are mm (3 decimals), design.md §4
+ANGLE_KEYS = frozenset({"angle", "alpha", "beta", "angle_2", "corner_angle", "setpoint_angle"})
+
+
+def fmt_result(key: str, value) -> str:
+    """A measuring result value: yes/no, degrees with 4 decimals, mm with 3, else as text."""
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, int | float):
+        return fixed(value, 4 if key in ANGLE_KEYS else 3)
+    return str(value)
+
+
 templates = Jinja2Blocks(directory=str(TEMPLATES_DIR))
 templates.env.globals["HORIZONTAL_SOFTKEYS"] = HORIZONTAL_SOFTKEYS
 templates.env.filters["mm"] = fmt_length
@@ -81,16 +99,21 @@ def _owner(template: str, block: str) -> str:
 
 def render_screen(request: Request, template: str, context: dict | None = None, status_code: int = 200):
     """Full page on a normal GET; on an htmx request the blocks screen + vsoftkeys + hsoftkeys."""
-    ctx = {"request": request, **base_context(request), **(context or {})}
     if not is_htmx(request):
+        ctx = {"request": request, **base_context(request), **(context or {})}
         return templates.TemplateResponse(request, template, ctx, status_code=status_code)
+    return render_blocks(request, template, SCREEN_BLOCKS, context, status_code)
+
+
+def render_blocks(request: Request, template: str, blocks: list[str], context: dict | None = None,
+                  status_code: int = 200, headers: dict | None = None):
+    """The named blocks, each from the template that defines it, one after the other."""
+    ctx = {"request": request, **base_context(request), **(context or {})}
     html = "".join(jinja2_fragments.render_block(templates.env, _owner(template, block), block, ctx)
-                   for block in SCREEN_BLOCKS)
-    return HTMLResponse(html, status_code=status_code)
+                   for block in blocks)
+    return HTMLResponse(html, status_code=status_code, headers=headers)
 
 
 def render_block(request: Request, template: str, block: str, context: dict | None = None,
                  status_code: int = 200, headers: dict | None = None):
-    ctx = {"request": request, **base_context(request), **(context or {})}
-    html = jinja2_fragments.render_block(templates.env, _owner(template, block), block, ctx)
-    return HTMLResponse(html, status_code=status_code, headers=headers)
+    return render_blocks(request, template, [block], context, status_code, headers)

@@ -24,8 +24,9 @@ from fastapi import APIRouter, Form, Request
 from fastapi.responses import RedirectResponse
 
 from app.workflow import setup_support as support
+from engine.frames import Frame
 
-from .templating import render_screen
+from .templating import render_screen, vkeys
 
 router = APIRouter()
 URL = "/measure/workpiece/tilted-setup"
@@ -38,10 +39,9 @@ def _state(db) -> dict:
         return dict(unit.get_state(STATE, None) or {})
 
 
-def _log_since(db, since: int) -> list[dict]:
-    with db.unit(readonly=True) as unit:
-        entries = unit.list_log(limit=200)
-    return [e for e in reversed(entries) if e["id"] > since and e.get("status") == "ok"]
+def _log_since(log, since: int) -> list[dict]:
+    """Successful log entries after ``since``, oldest first."""
+    return [e for e in reversed(log.list(200)) if e["id"] > since and e.get("status") == "ok"]
 
 
 def _measuring_wo(entry: dict) -> str | None:
@@ -55,7 +55,7 @@ def steps_model(services) -> dict:
     machine = services.machine
     plane = machine.plane()
     chain_wo = support.chain_wo(services.db)
-    entries = _log_since(services.db, int(state.get("since", 0))) if target else []
+    entries = _log_since(services.log, int(state.get("since", 0))) if target else []
 
     def find(pred, after: int = 0) -> dict | None:
         return next((e for e in entries if e["id"] > after and pred(e)), None)
@@ -92,22 +92,20 @@ def steps_model(services) -> dict:
         step["done"] = is_done
         step["current"] = step["n"] == current
         step["open"] = f"{URL}/open/{step['n']}"
-    offset = None
-    if target:
-        with services.db.unit(readonly=True) as unit:
-            offset = unit.list_offsets().get(target)
+    offset = services.offsets.list().get(target) if target else None
     return {"target": target, "steps": steps, "complete": all(done) and target is not None,
             "current": current, "chain_wo": chain_wo, "active": machine.active_offset,
             "aligned": aligned, "swivel": machine.has_swivel(), "offset": offset,
+            "translation": dict(zip("XYZ", Frame.from_api(offset).translation, strict=True)) if offset else None,
             "targets": [n for n in services.offsets.names() if n.startswith("G5")]}
 
 
 def _render(request: Request, notice: str = ""):
     services = request.app.state.services
     model = steps_model(services)
-    keys: list = [None] * 7 + [{"label": "Back", "href": "/measure/workpiece"}]
     return render_screen(request, "tilted_setup.html", {
-        "screen": "measure_workpiece", "m": model, "notice": notice, "vkeys": keys,
+        "screen": "measure_workpiece", "m": model, "notice": notice,
+        "vkeys": vkeys([], {"label": "Back", "href": "/measure/workpiece"}),
         "message": notice or _dialog(model)})
 
 
