@@ -7,7 +7,7 @@ import json
 import pytest
 from fastapi.testclient import TestClient
 from hmi_testdata import TEST_SCENARIO, test_scenario
-from live import CHROMIUM_ARGS, serve
+from live import CHROMIUM_ARGS, browser_tab, serve
 
 
 @pytest.fixture
@@ -53,11 +53,8 @@ def browser():
 
 @pytest.fixture
 def page(browser, live_server):
-    context = browser.new_context(viewport={"width": 1280, "height": 720}, base_url=live_server)
-    context.set_default_timeout(5000)
-    tab = context.new_page()
-    yield tab
-    context.close()
+    with browser_tab(browser, live_server) as tab:
+        yield tab
 
 
 @pytest.fixture

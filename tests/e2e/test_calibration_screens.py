@@ -62,6 +62,7 @@ def test_calibrate_radius_then_length_on_the_screens(page, api):
 
 
 def test_probe_data_screen_validates_and_saves(page, api):
+    before = api.get("/api/probes/2")
     page.goto("/probes?n=2")
     expect(page.locator("#screen")).to_have_attribute("data-record", "2")
     page.locator("#wp-trigger\\.X\\+").fill("abc")
@@ -69,7 +70,8 @@ def test_probe_data_screen_validates_and_saves(page, api):
     page.get_by_role("button", name=re.compile("Save")).click()
     expect(page.locator('[data-field="trigger.X+"] .field-error')).to_contain_text("not a number")
     expect(page.locator('[data-field="trigger.X-"] .field-error')).to_contain_text("positive")
-    assert api.get("/api/probes/2").status_code in (200, 404)
+    after = api.get("/api/probes/2")                                   # nothing stored
+    assert (after.status_code, after.json()) == (before.status_code, before.json())
     page.locator("#wp-trigger\\.X\\+").fill("-1.98")
     page.locator("#wp-trigger\\.X-").fill("1.97")
     page.locator("#wp-skew\\.X").fill("0.01")

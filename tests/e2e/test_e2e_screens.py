@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import pytest
+from hmi_testdata import TEST_SCENARIO
 from playwright.sync_api import expect
 
 pytestmark = pytest.mark.e2e
@@ -84,9 +85,10 @@ def test_machine_view_renders_scene_and_probe(page, api):
         expect(svg.locator("polygon.block")).to_have_count(1)
         expect(svg.locator(f"#probe-{view} circle.ball")).to_have_count(1)
     tip = page.locator("#scene-views .tip")
-    expect(tip).to_contain_text("X 100.000")
+    x = TEST_SCENARIO["start"]["X"]                 # the probe's tip is on the spindle axis
+    expect(tip).to_contain_text(f"X {x:.3f}")
     api.post("/api/machine/jog", json={"axis": "X", "distance": 25})
-    expect(tip).to_contain_text("X 125.000")
+    expect(tip).to_contain_text(f"X {x + 25:.3f}")
 
 
 def test_reset_key_clears_an_alarm(page, api):

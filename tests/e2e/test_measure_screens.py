@@ -14,6 +14,7 @@ import httpx
 import numpy as np
 import pytest
 from hmi_testdata import PROBE_LENGTH, test_scenario
+from live import browser_tab
 from playwright.sync_api import expect
 
 pytestmark = pytest.mark.e2e
@@ -104,11 +105,8 @@ def station(live_server):
 @pytest.fixture(scope="module")
 def tab(browser, live_server):
     """One browser tab for the module (a fresh context per test costs a second each)."""
-    context = browser.new_context(viewport={"width": 1024, "height": 768}, base_url=live_server)
-    context.set_default_timeout(8000)
-    page = context.new_page()
-    yield page
-    context.close()
+    with browser_tab(browser, live_server, 1024, 768, timeout_ms=8000) as page:
+        yield page
 
 
 def open_screen(tab, station: Station, kind: str, url: str):
