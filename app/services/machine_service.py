@@ -5,7 +5,8 @@ the tool tip: ``tip = axes - L * infeed_unit`` with L the NC's offset length (to
 wear) along the infeed axis of the measuring plane, and ``tip_mcs = wcs2bcs(p_wcs)`` (BCS = MCS).
 The active settable offset and the tool in the spindle are persisted in the db state.
 With a swivel head turned out of +Z the length goes along the machine's actual tool axis
-(``status().tool_axis``, TRAORI-like), so that WCS tip positions stay right (``length_axis``).
+(``status().tool_axis``, TRAORI-like), so that WCS tip positions stay right
+(``app.workflow.executor.length_axis``, which owns the tip <-> axes conversion).
 """
 
 from __future__ import annotations
@@ -13,12 +14,14 @@ from __future__ import annotations
 import math
 import threading
 from collections.abc import Callable, Mapping
+from contextlib import contextmanager
 
 import numpy as np
 
 from app.errors import AlarmError, BusyError, InvalidInput, NotFoundError
 from app.machine.protocol import ActiveFrame, Alarm, Machine, MachineAlarm, MachineBusy, MoveResult
 from app.machine.scenario import Scenario
+from app.workflow.executor import StepExecutor
 from db import Database
 from engine.frames import GEOMETRY_AXES, Frame, FrameChain
 from engine.planes import plane as plane_by_name
@@ -27,6 +30,7 @@ from .settings import SettingsService
 
 CHANNEL = "CHAN1"
 G500 = "G500"
+SETFRAME = "BASIC_REF"             # the system frame outside the basic frames
 PROBE_TOOL_TYPE = 710            # 3D probe, multidirectional (spec §10: 710/1xy)
 MAX_TRAVEL = 10_000.0            # mm; a bigger single move is a typo
 MAX_FEED = 50_000.0              # mm/min
@@ -38,6 +42,19 @@ def _finite(value, field: str) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
         raise InvalidInput(f"{field}: must be a finite number", field=field)
     return float(value)
+
+
+def basic_frame_names(names) -> tuple[str, ...]:
+    """BASIC_0, BASIC_1, … in chain order (BASIC_REF is the SETFRAME, outside all of them)."""
+    return tuple(sorted((n for n in names if n.startswith("BASIC_") and n != SETFRAME),
+                        key=lambda n: int(n.split("_")[1])))
+
+
+def frame_chain(offsets: Mapping[str, Frame], active: str) -> FrameChain:
+    """WCS->BCS = BASIC_REF ∘ BASIC_0 ∘ BASIC_1 ∘ … ∘ ``active`` (identity under G500)."""
+    return FrameChain(setframe=offsets.get(SETFRAME, Frame.identity()),
+                      basic=tuple(offsets[n] for n in basic_frame_names(offsets)),
+                      settable=Frame.identity() if active == G500 else offsets[active])
 
 
 def alarm_dict(alarm: Alarm) -> dict:
@@ -119,15 +136,6 @@ class MachineService:
     def has_swivel(self) -> bool:
         return bool(getattr(self._machine, "has_swivel", lambda: False)())
 
-    def length_axis(self, status=None) -> np.ndarray:
-        """The direction of the tool length L in MCS: the plane's infeed axis while the tool axis
-        is +Z (3-axis convention, any plane), the machine's actual tool axis when swivelled."""
-        st = status if status is not None else self._machine.status()
-        axis = np.asarray(getattr(st, "tool_axis", (0.0, 0.0, 1.0)), dtype=float)
-        if float(np.linalg.norm(axis - np.array([0.0, 0.0, 1.0]))) < 1e-12:
-            return self.plane().infeed_unit
-        return axis
-
     def retract_tool_axis(self, distance: float | None = None) -> dict:
         """Retract up along the tool axis (to the limits by default) before a swivel (spec §11 Q9)."""
         if distance is not None:
@@ -143,30 +151,27 @@ class MachineService:
         return self._run(lambda: self._machine.swivel_to_wcs(rotation, infeed))
 
     # --- coordinates ----------------------------------------------------------------------
-    def wcs_from_mcs(self, mcs: Mapping[str, float], tool_length: float | None = None) -> dict[str, float]:
+    def _tip(self, tool_length: float | None) -> StepExecutor:
+        """Tool tip <-> axis positions in the active chain (the executor owns the conversion)."""
         if tool_length is None:
             tool_length = self._machine.status().tool_length
-        chain = self._chain
-        axes_xyz = np.array([float(mcs[a]) for a in GEOMETRY_AXES])
-        tip_mcs = axes_xyz - tool_length * self.length_axis()
-        p_wcs = chain.wcs2bcs.parent2child(tip_mcs)
+        return StepExecutor(self._machine, self._chain.wcs2bcs, tool_length, self.plane().infeed_unit)
+
+    def wcs_from_mcs(self, mcs: Mapping[str, float], tool_length: float | None = None) -> dict[str, float]:
+        p_wcs = self._tip(tool_length).tip_in_wcs([float(mcs[a]) for a in GEOMETRY_AXES])
         out = {a: float(v) for a, v in zip(GEOMETRY_AXES, p_wcs, strict=True)}
         for axis in self.rotary_axes:
             if axis in mcs:
-                out[axis] = float(mcs[axis]) - chain.wcs2bcs.rotary_offset(axis)
+                out[axis] = float(mcs[axis]) - self._chain.wcs2bcs.rotary_offset(axis)
         return out
 
     def mcs_from_wcs(self, wcs: Mapping[str, float], tool_length: float | None = None) -> dict[str, float]:
         """Full WCS point (X, Y, Z; rotary optional) -> axis positions of the tool reference point."""
-        if tool_length is None:
-            tool_length = self._machine.status().tool_length
-        chain = self._chain
-        p_wcs = np.array([float(wcs[a]) for a in GEOMETRY_AXES])
-        axes_xyz = chain.wcs2bcs.child2parent(p_wcs) + tool_length * self.length_axis()
+        axes_xyz = self._tip(tool_length).axes_for_tip([float(wcs[a]) for a in GEOMETRY_AXES], "WCS")
         out = {a: float(v) for a, v in zip(GEOMETRY_AXES, axes_xyz, strict=True)}
         for axis in self.rotary_axes:
             if axis in wcs:
-                out[axis] = float(wcs[axis]) + chain.wcs2bcs.rotary_offset(axis)
+                out[axis] = float(wcs[axis]) + self._chain.wcs2bcs.rotary_offset(axis)
         return out
 
     # --- motion -----------------------------------------------------------------------------
@@ -192,14 +197,21 @@ class MachineService:
             raise AlarmError(result.alarm.code, result.alarm.text)
         return self.status()
 
-    def _run(self, motion: Callable[[], MoveResult]) -> dict:
-        self._ensure_idle()
+    @staticmethod
+    @contextmanager
+    def _machine_errors():
+        """The machine's busy/alarm exceptions as the API's errors."""
         try:
-            result = motion()
+            yield
         except MachineBusy as exc:
             raise BusyError(str(exc) or "a motion is running") from None
         except MachineAlarm as exc:
             raise AlarmError(exc.alarm.code, exc.alarm.text) from None
+
+    def _run(self, motion: Callable[[], MoveResult]) -> dict:
+        self._ensure_idle()
+        with self._machine_errors():
+            result = motion()
         return self._finish(result)
 
     def jog(self, axis: str, distance: float, feed: float | None = None) -> dict:
@@ -216,12 +228,8 @@ class MachineService:
             raise InvalidInput("direction: must be -1 or +1", field="direction")
         feed = self._check_feed(feed)
         self._ensure_idle()
-        try:
+        with self._machine_errors():
             self._machine.jog_continuous(axis, direction, feed)
-        except MachineBusy as exc:
-            raise BusyError(str(exc) or "a motion is running") from None
-        except MachineAlarm as exc:
-            raise AlarmError(exc.alarm.code, exc.alarm.text) from None
         return self.status()
 
     def stop(self) -> dict:
@@ -267,12 +275,8 @@ class MachineService:
             raise InvalidInput(f"distance: must be > 0 and <= {MAX_TRAVEL:g}", field="distance")
         feed = self._check_feed(_finite(feed, "feed"))
         self._ensure_idle()
-        try:
+        with self._machine_errors():
             result = self._machine.probe(d, distance, feed)
-        except MachineBusy as exc:
-            raise BusyError(str(exc) or "a motion is running") from None
-        except MachineAlarm as exc:
-            raise AlarmError(exc.alarm.code, exc.alarm.text) from None
         latched = None if result.latched_mcs is None else {a: float(v) for a, v in result.latched_mcs.items()}
         return {
             "triggered": bool(result.triggered),
@@ -334,13 +338,10 @@ class MachineService:
             length = self.offset_length(data)
         self._ensure_idle()
         try:
-            self._machine.change_tool(t, length)
+            with self._machine_errors():
+                self._machine.change_tool(t, length)
         except ValueError as exc:      # the tool table knows it, the machine's magazine does not
             raise InvalidInput(f"tool: {exc}", field="tool") from None
-        except MachineBusy as exc:
-            raise BusyError(str(exc) or "a motion is running") from None
-        except MachineAlarm as exc:
-            raise AlarmError(exc.alarm.code, exc.alarm.text) from None
         with self._db.unit() as unit:
             unit.set_state(STATE_TOOL, t)
         return self.status()
@@ -364,16 +365,9 @@ class MachineService:
         return isinstance(name, str) and name in names and not name.startswith("BASIC")
 
     def build_chain(self, active: str) -> FrameChain:
-        """WCS->BCS = BASIC_REF ∘ BASIC_0 ∘ BASIC_1 ∘ … ∘ settable (identity under G500)."""
         with self._db.unit(readonly=True) as unit:
-            offsets = unit.list_offsets()
-        basic_names = sorted((n for n in offsets if n.startswith("BASIC_") and n != "BASIC_REF"),
-                             key=lambda n: int(n.split("_")[1]))
-        return FrameChain(
-            setframe=Frame.from_api(offsets["BASIC_REF"]) if "BASIC_REF" in offsets else Frame.identity(),
-            basic=tuple(Frame.from_api(offsets[n]) for n in basic_names),
-            settable=Frame.identity() if active == G500 else Frame.from_api(offsets[active]),
-        )
+            offsets = {n: Frame.from_api(f) for n, f in unit.list_offsets().items()}
+        return frame_chain(offsets, active)
 
     def activate(self, name: str) -> dict:
         if not isinstance(name, str) or not self._is_settable(name.upper()):

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from app.machine.protocol import Alarm, Machine
-from app.services.machine_service import G500, MachineService
+from app.services.machine_service import G500, MachineService, basic_frame_names, frame_chain
 from app.services.settings import SettingsService
 from app.workflow.service import MeasuringContext
 from db import Database
@@ -58,21 +58,18 @@ class MeasuringEnv:
         gud = self._settings.get()
         with self._db.unit(readonly=True) as unit:
             offsets = {n: Frame.from_api(f) for n, f in unit.list_offsets().items()}
-            names = unit.offset_names()
             tool = unit.get_tool(st.tool) if st.tool is not None else None
             probe_no = probe_number_for(unit.list_probes(), st.tool, int(gud.probe_number))
             probe_data = unit.get_probe(probe_no)
             tool_probe = unit.get_tool_probe(int(gud.tool_probe_number))
-        basic = sorted((n for n in names if n.startswith("BASIC_") and n != "BASIC_REF"),
-                       key=lambda n: int(n.split("_")[1]))
-        chain_names = tuple((["BASIC_REF"] if "BASIC_REF" in names else []) + basic)
         is_probe = bool(tool) and int(tool.get("type", 0)) in PROBE_TYPES
         probe = probe_record_from(probe_data, tool, gud.length_to_tip) if is_probe else None
         active = self._ms.active_offset
         return MeasuringContext(
             active_offset=active,
             offsets=offsets,
-            chain_names=chain_names,
+            frame_chain=frame_chain(offsets, active),
+            basic_names=basic_frame_names(offsets),
             plane=self._ms.plane(),
             tool_length=float(st.tool_length),
             tool=tool,

@@ -20,6 +20,17 @@ class MotionAborted(Exception):
     """The motion was stopped without an alarm (Reset)."""
 
 
+def length_axis(status, infeed_unit) -> np.ndarray:
+    """Direction of the tool length L in MCS: the plane's infeed unit while the tool axis is +Z
+    (3-axis convention, any plane); TRAORI-like, a swivelled head's actual tool axis (status)."""
+    axis = getattr(status, "tool_axis", None)
+    if axis is not None:
+        axis = np.asarray(axis, dtype=float)
+        if axis.shape == (3,) and float(np.linalg.norm(axis - np.array([0.0, 0.0, 1.0]))) >= 1e-12:
+            return axis
+    return np.asarray(infeed_unit, dtype=float)
+
+
 @dataclass
 class StepExecutor:
     machine: Machine
@@ -28,12 +39,7 @@ class StepExecutor:
     tool_axis_mcs: np.ndarray   # unit vector from tool tip to spindle (G17: +Z)
 
     def __post_init__(self) -> None:
-        # TRAORI-like: a swivelled head's actual tool axis (status) replaces the plane's infeed unit
-        axis = getattr(self.machine.status(), "tool_axis", None)
-        if axis is not None:
-            axis = np.asarray(axis, dtype=float)
-            if axis.shape == (3,) and float(np.linalg.norm(axis - np.array([0.0, 0.0, 1.0]))) >= 1e-12:
-                self.tool_axis_mcs = axis
+        self.tool_axis_mcs = length_axis(self.machine.status(), self.tool_axis_mcs)
 
     # --- conversions (names carry the direction) ----------------------------------------
     def axes_mcs(self) -> np.ndarray:
@@ -53,7 +59,7 @@ class StepExecutor:
         axes = self.axes_mcs()
         return self.tip_in_wcs(axes) if coords == "WCS" else self.tip_in_mcs(axes)
 
-    def _target_axes(self, target, coords: str) -> np.ndarray:
+    def axes_for_tip(self, target, coords: str) -> np.ndarray:
         tip_mcs = self.wcs2bcs.child2parent(target) if coords == "WCS" else np.asarray(target, float)
         return self.axes_for_tip_mcs(tip_mcs)
 
@@ -69,7 +75,7 @@ class StepExecutor:
 
     def run(self, step: Step) -> Latch | None:
         if isinstance(step, MoveStep):
-            axes = self._target_axes(step.target, step.coords)
+            axes = self.axes_for_tip(step.target, step.coords)
             result = self.machine.goto({"X": axes[0], "Y": axes[1], "Z": axes[2]}, step.feed)
             if not result.completed:
                 self._raise_for(result.alarm)

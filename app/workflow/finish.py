@@ -55,7 +55,7 @@ def finish_workpiece(session: MeasureSession, ctx: MeasuringContext) -> tuple[di
         answer["correction"]["rotary_axis"] = correction.rotary_axis
         answer["correction"]["rotary_move"] = correction.rotary_move
 
-    in_chain = target in ctx.chain_names
+    in_chain = ctx.in_chain(target)
     reasons = []
     if not in_chain and target != ctx.active_offset:
         reasons.append({"code": "inactive_wo", "text": "You are compensating in an inactive WO!",

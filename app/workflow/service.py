@@ -10,7 +10,6 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from functools import cached_property
 from typing import Protocol
 
 import numpy as np
@@ -39,7 +38,8 @@ class MeasuringContext:
 
     active_offset: str                  # WO active while measuring ("G500", "G54", ..)
     offsets: dict[str, Frame]           # every stored frame by name
-    chain_names: tuple[str, ...]        # frames outside the settable one, MCS side first
+    frame_chain: FrameChain             # WCS -> BCS while measuring (settable = active_offset)
+    basic_names: tuple[str, ...]        # names of frame_chain.basic (BASIC_0, BASIC_1, ..)
     plane: Plane
     tool_length: float                  # NC offset length of the tool in the spindle
     tool: dict | None                   # tool table row of the tool in the spindle
@@ -51,29 +51,20 @@ class MeasuringContext:
     extra: dict = field(default_factory=dict)
 
     def chain(self) -> FrameChain:
-        return self._chain
+        return self.frame_chain
 
-    @cached_property
-    def _chain(self) -> FrameChain:
-        outside = [self.offsets[n] for n in self.chain_names]
-        settable = self.offsets.get(self.active_offset, Frame.identity())
-        return FrameChain(setframe=outside[0] if outside else Frame.identity(),
-                          basic=tuple(outside[1:]), settable=settable)
+    @staticmethod
+    def in_chain(target: str) -> bool:
+        """A basic frame (BASIC_REF, BASIC_n): always part of the active chain, unlike a WO."""
+        return target.startswith("BASIC")
 
     def parent2bcs_of(self, target: str) -> Frame:
         """Composition of the frames outside ``target`` (MCS side first)."""
-        frames: list[Frame] = []
-        for name in self.chain_names:
-            if name == target:
-                break
-            frames.append(self.offsets[name])
-        else:
-            if target in self.chain_names:
-                frames = []
-        total = Frame.identity()
-        for f in frames:
-            total = total.compose(f)
-        return total
+        if target in self.basic_names:
+            return self.frame_chain.parent2bcs_of_basic(self.basic_names.index(target))
+        if self.in_chain(target):           # BASIC_REF, the SETFRAME: nothing outside it
+            return Frame.identity()
+        return self.frame_chain.below_settable
 
 
 class WorkflowEnv(Protocol):

@@ -14,7 +14,7 @@ NC Start (``carry_out``):
   The manual's toggle field 3 says "空运行" (dry run / traverse); the spec's function is kept.
 - with a swivel head (scenario ``machine.kinematics``), NC Start activates first, then retracts
   and swivels the head so that the tool axis is ∥ the infeed axis of the (new) active WCS; the
-  WCS follows the kinematics (MachineService.length_axis), measuring goes on in the tilted WCS.
+  WCS follows the kinematics (app.workflow.executor.length_axis), measuring goes on in the tilted WCS.
 - position rotary axis (spec §2.5.2, §11 Q8): turn the axis by the correction's ``rotary_move``
   from where it stood while measuring, so that the edge lies at the setpoint angle.
 
