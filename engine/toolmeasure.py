@@ -24,7 +24,7 @@ from engine.types import MeasuringError
 
 __all__ = [
     "SpindleFeeds", "calibrate_tool_probe", "calibrate_tool_probe_point", "compensation_table_value",
-    "evaluate_tool_task", "probe_centre", "spindle_speed_feeds", "tool_length", "tool_offset_update", "tool_point_value",
+    "evaluate_tool_task", "latch_delay_correction", "probe_centre", "spindle_speed_feeds", "tool_length", "tool_offset_update", "tool_point_value",
     "tool_radius",
 ]
 
@@ -218,3 +218,30 @@ def evaluate_tool_task(task: str, params: dict, point, plane: Plane, tool_probe:
     if name == "radius":
         values["diameter"] = 2.0 * measured
     return tool, values
+
+
+def latch_delay_correction(stage_tips: Sequence, key: str, feeds: Sequence[float], override: float,
+                           cal_feed: float, cal_override: float, min_feed_spread: float = 1.0
+                           ) -> tuple[float | None, float]:
+    """Signal delay t [s] of a flying tool measurement and the correction (v_meas − v_cal)·t.
+
+    design.md §5, measuring-math §1.5 e_lat = v·t: calibration runs at E_MESS_MT_FM, rotating
+    measuring at F = n·E_MESS_MIN_D, so a delay t leaves (v_meas − v_cal)·t in the result. [I] The
+    stages of the final probing touch the same point at ``feeds`` (mm/min, last = measuring
+    feed); their latched tool tips ``stage_tips`` (MCS, None = no latch) give s_i = S + v_i·t
+    along the travel ``key`` ("Z-", "X+", least squares, a delay is never negative). Referring
+    measurement and calibration (``cal_feed`` at ``cal_override`` %) to feed 0 adds
+    (v_meas − v_cal)·t, v = feed·override. t is None (correction 0) when the stages cannot tell:
+    fewer than two, one without a latch, or feeds less than ``min_feed_spread`` mm/min apart.
+    """
+    v = np.asarray(feeds, dtype=float) * override / 100.0 / 60.0          # mm/s
+    if (len(v) < 2 or len(stage_tips) != len(v) or any(tip is None for tip in stage_tips)
+            or np.ptp(v) * 60.0 < min_feed_spread):
+        return None, 0.0
+    d = np.zeros(3)
+    d[axis_index(key[0])] = 1.0 if key[1] == "+" else -1.0
+    s = np.array([float(np.asarray(tip, dtype=float) @ d) for tip in stage_tips])
+    vc = v - v.mean()
+    t = max(0.0, float(vc @ (s - s.mean()) / (vc @ vc)))
+    v_cal = cal_feed * cal_override / 100.0 / 60.0
+    return t, float((v[-1] - v_cal) * t)

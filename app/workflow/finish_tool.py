@@ -10,28 +10,27 @@ engine.toolmeasure. The points come from engine.plan_tool (tool tip in MCS at th
   geometry := measured, the wear of that component := 0; ``wear`` -> wear := measured − geometry.
   The API parameter ``compensation`` overrides the setting ``tool_offset_mode`` (_JM_B[0]).
 
-Latch delay (design.md §5 flying measurement, measuring-math §1.5 e_lat = v·t): calibration runs
-at E_MESS_MT_FM, rotating-spindle measuring at F = n·E_MESS_MIN_D (≈ 10 mm/min), so a signal
-delay t leaves (v_meas − v_cal)·t in the result (4 ms: 6 µm). [I] The two probing stages of a
-measurement touch the same point at different feeds; their latched positions give t, and the
-result is referred to feed 0 on both sides: value += (v_meas − v_cal)·t (v = feed·override).
+Latch delay (design.md §5 flying measurement): the stages of the final probing give the signal
+delay and measurement and calibration are referred to feed 0; the math is
+``engine.toolmeasure.latch_delay_correction``, the finisher hands it the stages' latches.
 """
 
 from __future__ import annotations
 
 from datetime import UTC, datetime
 
-import numpy as np
-
 from app.workflow.planning import active_tool, tool_probe_widths
 from app.workflow.service import MeasureSession, MeasuringContext
 from engine.plan_base import ToolPoint, ToolProbePoint
-from engine.planes import axis_index
-from engine.toolmeasure import calibrate_tool_probe_point, tool_offset_update, tool_point_value
+from engine.toolmeasure import (
+    calibrate_tool_probe_point,
+    latch_delay_correction,
+    tool_offset_update,
+    tool_point_value,
+)
 from engine.types import MeasuringError
 
 TOOL_KEYS = ("t", "name", "type", "length", "radius", "wear")
-MIN_FEED_SPREAD = 1.0           # mm/min between the stages needed to estimate the latch delay
 
 
 def _now() -> str:
@@ -114,43 +113,19 @@ def finish_toolprobe_calibrate(session: MeasureSession, ctx: MeasuringContext) -
     return answer, {"offset": None, "tool_probe_update": (n, record)}
 
 
-# --- latch delay ----------------------------------------------------------------------------------
+# --- latch delay (math in engine.toolmeasure.latch_delay_correction) -----------------------------
 
-def _direction(key: str) -> np.ndarray:
-    d = np.zeros(3)
-    d[axis_index(key[0])] = 1.0 if key[1] == "+" else -1.0
-    return d
-
-
-def latch_delay(raw: list[dict], point, override: float) -> float | None:
-    """Signal delay t [s] from the stages of the final probing (same point, different feeds):
-    s_i = S + v_i·t along the travel (least squares); None if the stages cannot tell."""
-    k = len(point.feeds)
-    if k < 2 or len(raw) < k:
-        return None
-    stages = raw[-k:]
-    if not all(r.get("triggered") and r.get("rec") is not None for r in stages):
-        return None
-    d = _direction(point.touch.key)
-    s = np.array([float(np.asarray(r["rec"], float) @ d) for r in stages])
-    v = np.array(point.feeds, float) * override / 100.0 / 60.0          # mm/s
-    if np.ptp(v) * 60.0 < MIN_FEED_SPREAD:
-        return None
-    vc = v - v.mean()
-    return max(0.0, float(vc @ (s - s.mean()) / (vc @ vc)))      # a delay is never negative
-
-
-def latch_correction(session: MeasureSession, point, record: dict, ctx: MeasuringContext) -> dict:
-    """value* = value + (v_meas − v_cal)·t (both latches referred to feed 0; module docstring)."""
+def latch_correction(session: MeasureSession, point: ToolPoint, record: dict, ctx: MeasuringContext) -> dict:
+    """value* = value + (v_meas − v_cal)·t from the final probing's stages (module docstring)."""
     override = float(ctx.feed_override)
-    t = latch_delay(session.slots[0].raw, point, override)
-    v_meas = float(point.feeds[-1]) * override / 100.0 / 60.0
+    stages = session.slots[0].raw[-len(point.feeds):]
+    tips = [r.get("rec") if r.get("triggered") else None for r in stages]
     cal_feed = float(record.get("calibration_feed") or ctx.settings.get("mt_fm", 100.0))
     cal_override = record.get("calibration_override")
-    v_cal = cal_feed * float(override if cal_override is None else cal_override) / 100.0 / 60.0
-    correction = 0.0 if t is None else (v_meas - v_cal) * t
+    t, correction = latch_delay_correction(tips, point.touch.key, point.feeds, override, cal_feed,
+                                           override if cal_override is None else float(cal_override))
     return {"delay_s": t, "feed": float(point.feeds[-1]), "calibration_feed": cal_feed,
-            "correction": float(correction)}
+            "correction": correction}
 
 
 # --- tool length / radius (spec §7.3, math §14.4) -----------------------------------------------

@@ -164,3 +164,20 @@ def test_evaluate_tool_task_wrappers():
     assert values["radius"] == pytest.approx(17.900, abs=1e-9)
     assert values["diameter"] == pytest.approx(35.800, abs=1e-9)
     assert tool["radius"] == 18.0 and tool["wear"]["radius"] == pytest.approx(-0.100, abs=1e-9)
+
+
+def test_latch_delay_from_two_stages_at_different_feeds():
+    """Latched tip = switch point + v·t along the travel (design.md §5): two stages at 100 and
+    10 mm/min give t back, and the correction refers a 10 mm/min measurement to a 100 mm/min
+    calibration: (v_meas − v_cal)·t."""
+    from engine.toolmeasure import latch_delay_correction
+
+    t_true, switch_z = 0.004, -137.25
+    feeds = [100.0, 10.0]
+    tips = [np.array([0.0, 0.0, switch_z - f / 60.0 * t_true]) for f in feeds]   # travel −Z
+    t, correction = latch_delay_correction(tips, "Z-", feeds, 100.0, cal_feed=100.0, cal_override=100.0)
+    assert t == pytest.approx(t_true, rel=1e-9)
+    assert correction == pytest.approx((10.0 - 100.0) / 60.0 * t_true, rel=1e-9)
+    # stages that cannot tell the delay apart give no correction
+    assert latch_delay_correction(tips[:1], "Z-", feeds[:1], 100.0, 100.0, 100.0) == (None, 0.0)
+    assert latch_delay_correction([tips[0], None], "Z-", feeds, 100.0, 100.0, 100.0) == (None, 0.0)
