@@ -26,45 +26,18 @@ def get_services(request: Request) -> Services:
 ServicesDep = Annotated[Services, Depends(get_services)]
 
 
-def _machine(services: ServicesDep) -> MachineService:
-    return services.machine
+def _part(name: str):
+    """``Depends`` on one part of the ``Services`` container."""
+    def get(services: ServicesDep):
+        return getattr(services, name)
+    return Depends(get)
 
 
-def _offsets(services: ServicesDep) -> OffsetService:
-    return services.offsets
-
-
-def _tools(services: ServicesDep) -> ToolService:
-    return services.tools
-
-
-def _probes(services: ServicesDep) -> ProbeService:
-    return services.probes
-
-
-def _tool_probes(services: ServicesDep) -> ToolProbeService:
-    return services.tool_probes
-
-
-def _log(services: ServicesDep) -> LogService:
-    return services.log
-
-
-def _settings(services: ServicesDep) -> SettingsService:
-    return services.settings
-
-
-MachineDep = Annotated[MachineService, Depends(_machine)]
-OffsetsDep = Annotated[OffsetService, Depends(_offsets)]
-ToolsDep = Annotated[ToolService, Depends(_tools)]
-ProbesDep = Annotated[ProbeService, Depends(_probes)]
-ToolProbesDep = Annotated[ToolProbeService, Depends(_tool_probes)]
-SettingsDep = Annotated[SettingsService, Depends(_settings)]
-LogDep = Annotated[LogService, Depends(_log)]
-
-
-def _workflow(services: ServicesDep) -> WorkflowService:
-    return services.workflow
-
-
-WorkflowDep = Annotated[WorkflowService, Depends(_workflow)]
+MachineDep = Annotated[MachineService, _part("machine")]
+OffsetsDep = Annotated[OffsetService, _part("offsets")]
+ToolsDep = Annotated[ToolService, _part("tools")]
+ProbesDep = Annotated[ProbeService, _part("probes")]
+ToolProbesDep = Annotated[ToolProbeService, _part("tool_probes")]
+SettingsDep = Annotated[SettingsService, _part("settings")]
+LogDep = Annotated[LogService, _part("log")]
+WorkflowDep = Annotated[WorkflowService, _part("workflow")]
