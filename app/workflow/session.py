@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import uuid
 from dataclasses import dataclass, field
 
@@ -14,8 +15,8 @@ def _axes_dict(vec: np.ndarray) -> dict[str, float]:
     return {a: float(v) for a, v in zip(("X", "Y", "Z"), vec, strict=True)}
 
 
-def stored_point_to_api(point: StoredPoint | None) -> dict | None:
-    """JSON view of a stored point (surface point or centre, in the measuring WCS)."""
+def stored_point_to_api(point) -> dict | None:
+    """JSON view of a stored point (surface point or centre, in the measuring WCS; tool points in MCS)."""
     if point is None:
         return None
     if isinstance(point, EdgePoint):
@@ -27,8 +28,18 @@ def stored_point_to_api(point: StoredPoint | None) -> dict | None:
     if isinstance(point, RectPoint):
         return {"center": _axes_dict(point.center), "length": float(point.length),
                 "width": float(point.width)}
-    to_api = getattr(point, "to_api", None)
-    return to_api() if callable(to_api) else {"kind": type(point).__name__}
+    return {"type": type(point).__name__, **_plain(point)}   # tool / calibration points: all fields
+
+
+def _plain(value):
+    """JSON view of an engine point: dataclasses as objects, arrays and tuples as lists."""
+    if dataclasses.is_dataclass(value):
+        return {f.name: _plain(getattr(value, f.name)) for f in dataclasses.fields(value)}
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple | np.ndarray):
+        return [_plain(v) for v in value]
+    return value.item() if isinstance(value, np.generic) else value
 
 
 @dataclass

@@ -221,6 +221,20 @@ def test_latch_delay_is_compensated_between_calibration_and_rotating_feed(api):
     assert latch["correction"] == pytest.approx((10.0 - 100.0) / 60.0 * LATENCY, abs=1e-7)
 
 
+def test_the_log_keeps_the_tool_point_with_its_data(api):
+    """The logged P1 of a tool measurement carries its touch, not only its kind: the tool tip at
+    the latch as the NC computed it (with the nominal L1), pre-travel + latch path below the top."""
+    api.calibrate("length_diameter")
+    answer = api.length(CUTTER_T)
+    point = ok(api.c.get(f"/api/log/{answer['log_id']}"))["points"]["P1"]
+    feeds = answer["result"]["spindle"]["feeds"]
+    assert point["type"] == "ToolPoint" and point["kind"] == "length"
+    assert point["feeds"] == pytest.approx(feeds) and point["touch"]["key"] == "Z-"
+    late = TP_PRETRAVEL + feeds[-1] / 60.0 * LATENCY
+    nominal_error = TRUE[CUTTER_T]["length"] - TRUE[CUTTER_T]["nominal"]["length"]
+    assert point["touch"]["rec"][2] == pytest.approx(TP_CENTER[2] - late + nominal_error, abs=1e-6)
+
+
 def test_offset_v_special_cutting_edges(api):
     """Offset V moves the contact (length: in the plane; diameter: up): flat-end cutters stay true."""
     api.calibrate("length_diameter")
