@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from live import serve
+from live import browser_tab, serve
 from playwright.sync_api import expect
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "flows"))
@@ -51,10 +51,8 @@ def http(server):
 
 @pytest.fixture
 def tab(browser, server):
-    context = browser.new_context(viewport={"width": 1280, "height": 800}, base_url=server)
-    context.set_default_timeout(8000)
-    yield context.new_page()
-    context.close()
+    with browser_tab(browser, server, 1280, 800, timeout_ms=8000) as page:
+        yield page
 
 
 def load(http, scenario: dict) -> Operator:

@@ -14,12 +14,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from live import serve
+from live import browser_tab, serve
 from playwright.sync_api import expect
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "flows"))
 from test_chain_swivel import TOP_POINTS, SwivelOperator, swivel  # noqa: E402
-from test_chain_truth import CHAIN_SCENARIO, pose_errors, rpy  # noqa: E402
+from test_chain_truth import CHAIN_SCENARIO, pose_errors, rpy, run_points  # noqa: E402
 
 pytestmark = pytest.mark.e2e
 SWIVEL = swivel(CHAIN_SCENARIO, ("A", "B"))
@@ -41,34 +41,14 @@ def http(server):
 
 @pytest.fixture
 def tab(browser, server):
-    context = browser.new_context(viewport={"width": 1280, "height": 800}, base_url=server)
-    context.set_default_timeout(8000)
-    yield context.new_page()
-    context.close()
+    with browser_tab(browser, server, 1280, 800, timeout_ms=8000) as page:
+        yield page
 
 
 def load(http) -> SwivelOperator:
     r = http.post("/api/sim/scenario", json={**SWIVEL, "reset_data": True})
     assert r.status_code == 200, r.text
     return SwivelOperator(http, SWIVEL)
-
-
-def post(http, url, body=None) -> dict:
-    r = http.post(url, json=body or {})
-    assert r.status_code == 200, r.text
-    return r.json()
-
-
-def measure(http, op, task, params, starts, target=None) -> dict:
-    session = post(http, "/api/measure", {"task": task, "params": params, "target": target})
-    answer = None
-    for p in starts:
-        op.ball_to(p)
-        answer = post(http, f"/api/measure/{session['id']}/start")
-    if len(starts) > 1:
-        answer = post(http, f"/api/measure/{session['id']}/calculate")
-    answer["_session"] = session["id"]
-    return answer
 
 
 def angle_deg(u, v) -> float:
@@ -78,7 +58,7 @@ def angle_deg(u, v) -> float:
 def test_example2_orient_plane_with_swivel(tab, http):
     op = load(http)
     http.post("/api/machine/activate", json={"offset": "G500"})
-    answer = measure(http, op, "plane.align", {}, TOP_POINTS, target="G54")
+    answer = run_points(http, op, "plane.align", {}, TOP_POINTS, target="G54")
     tab.goto(f"/measure/setup-support/{answer['_session']}")
     expect(tab.locator("#ss-top-line")).to_have_text("The new WCS needs a new alignment!")
     expect(tab.locator('[data-toggle="realign"] select')).to_be_enabled()
@@ -117,7 +97,7 @@ def test_guided_tilted_setup_one_pass(tab, http):
     tab.locator("#ts-open-1").click()
     tab.wait_for_url("**/measure/workpiece/plane")
     assert http.get("/api/machine").json()["active_offset"] == "G500"
-    answer = measure(http, op, "plane.align", {}, TOP_POINTS, target="G54")
+    answer = run_points(http, op, "plane.align", {}, TOP_POINTS, target="G54")
     tab.goto("/measure/workpiece/tilted-setup")
     expect(tab.locator('[data-step="1"]')).to_have_attribute("data-done", "yes")
     # 2 set-up support: activate + retract + re-align (NC Start on the activation screen)
@@ -133,7 +113,7 @@ def test_guided_tilted_setup_one_pass(tab, http):
     tab.locator("#ts-open-3").click()
     tab.wait_for_url("**/measure/workpiece/corner/right")
     expect(tab.locator('select[name="target"]')).to_have_value("G54")
-    measure(http, op, "corner.right", {"kind": "outside", "position": 1, "setpoint": {"X": 0, "Y": 0}},
+    run_points(http, op, "corner.right", {"kind": "outside", "position": 1, "setpoint": {"X": 0, "Y": 0}},
             [(40, -8, -6), (150, -8, -6), (-8, 50, -6)], target="G54")
     tab.goto("/measure/workpiece/tilted-setup")
     expect(tab.locator('[data-step="3"]')).to_have_attribute("data-done", "yes")
@@ -141,7 +121,7 @@ def test_guided_tilted_setup_one_pass(tab, http):
     tab.locator("#ts-open-4").click()
     tab.wait_for_url("**/measure/workpiece/edge/set")
     expect(tab.locator('select[name="target"]')).to_have_value("G54")
-    measure(http, op, "edge.set", {"axis": "Z", "direction": "-", "setpoint": 0}, [(100, 60, 6)], target="G54")
+    run_points(http, op, "edge.set", {"axis": "Z", "direction": "-", "setpoint": 0}, [(100, 60, 6)], target="G54")
     tab.goto("/measure/workpiece/tilted-setup")
     expect(tab.locator("#screen")).to_have_attribute("data-complete", "yes")
     expect(tab.locator("#ts-complete")).to_be_visible()

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 from fastapi.testclient import TestClient
+from truthkit import rpy
 
 SAFE_Z = -100.0      # G500 WCS Z of the ball centre above everything (spindle near MCS Z 0)
 
@@ -172,10 +173,3 @@ class Flow:
         return float(np.linalg.norm(dt)), angle, dt
 
 
-def rpy(rot_deg) -> np.ndarray:
-    """R = Rz(c) · Ry(b) · Rx(a) (design.md §3: about Z, then new Y, then new X)."""
-    a, b, c = (math.radians(float(v)) for v in rot_deg)
-    rx = np.array([[1, 0, 0], [0, math.cos(a), -math.sin(a)], [0, math.sin(a), math.cos(a)]])
-    ry = np.array([[math.cos(b), 0, math.sin(b)], [0, 1, 0], [-math.sin(b), 0, math.cos(b)]])
-    rz = np.array([[math.cos(c), -math.sin(c), 0], [math.sin(c), math.cos(c), 0], [0, 0, 1]])
-    return rz @ ry @ rx

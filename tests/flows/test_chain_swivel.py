@@ -12,13 +12,21 @@ and the angles it reads from ``/api/machine``; truth = the scenario pose.
 from __future__ import annotations
 
 import copy
-import json
 import math
 
 import numpy as np
 import pytest
 from fastapi.testclient import TestClient
-from test_chain_truth import CHAIN_SCENARIO, calibrate, noisy_scenario, pose_errors, post, rpy
+from test_chain_truth import (
+    CHAIN_SCENARIO,
+    calibrate,
+    make_client,
+    noisy_scenario,
+    pose_errors,
+    post,
+    rpy,
+    run_points,
+)
 
 CLEAR_Z = 5.0
 TOP_POINTS = [(30, 25, 8), (170, 30, 8), (100, 100, 8)]
@@ -68,27 +76,6 @@ class SwivelOperator:
         mcs = self.c.get("/api/machine").json()["mcs"]
         axes = np.array([mcs["X"], mcs["Y"], mcs["Z"]])
         return axes + self.head() @ (self.ecc - np.array([0.0, 0.0, self.length]))
-
-
-def make_client(tmp_path, scenario: dict) -> TestClient:
-    from app.config import Settings
-    from app.main import create_app
-
-    path = tmp_path / "swivel.json"
-    path.write_text(json.dumps(scenario))
-    return TestClient(create_app(Settings(db_path=tmp_path / "swivel.db", scenario_path=path)))
-
-
-def run_points(client, op, task, params, starts, target=None) -> dict:
-    session = post(client, "/api/measure", {"task": task, "params": params, "target": target})
-    answer = None
-    for p in starts:
-        op.ball_to(p)
-        answer = post(client, f"/api/measure/{session['id']}/start")
-    if len(starts) > 1:
-        answer = post(client, f"/api/measure/{session['id']}/calculate")
-    answer["_session"] = session["id"]
-    return answer
 
 
 def chain(client, op: SwivelOperator, scenario: dict) -> dict:

@@ -10,12 +10,13 @@ looking at the true part (design.md §5 machine view), always up, across, then d
 from __future__ import annotations
 
 import copy
-import json
 import math
 
 import numpy as np
 import pytest
 from fastapi.testclient import TestClient
+from flowkit import make_client
+from truthkit import rpy
 
 BALL = 4.0
 PROBE_LENGTH = 100.0
@@ -48,14 +49,6 @@ def noisy_scenario(sigma: float = 0.0003) -> dict:
 
 
 # --- independent truth ---------------------------------------------------------------------
-
-def rpy(rot_deg) -> np.ndarray:
-    a, b, c = (math.radians(v) for v in rot_deg)
-    rx = np.array([[1, 0, 0], [0, math.cos(a), -math.sin(a)], [0, math.sin(a), math.cos(a)]])
-    ry = np.array([[math.cos(b), 0, math.sin(b)], [0, 1, 0], [-math.sin(b), 0, math.cos(b)]])
-    rz = np.array([[math.cos(c), -math.sin(c), 0], [math.sin(c), math.cos(c), 0], [0, 0, 1]])
-    return rz @ ry @ rx
-
 
 class Operator:
     """Positions the probe ball by looking at the true part (never through the HMI's numbers)."""
@@ -170,15 +163,6 @@ def pose_errors(g54: dict, scenario: dict) -> tuple[float, float]:
     sin_vec = 0.5 * np.array([d[2, 1] - d[1, 2], d[0, 2] - d[2, 0], d[1, 0] - d[0, 1]])
     rot_err = math.degrees(math.atan2(float(np.linalg.norm(sin_vec)), (np.trace(d) - 1.0) / 2.0))
     return rot_err, float(np.linalg.norm(t_g54 - t_true))
-
-
-def make_client(tmp_path, scenario: dict):
-    from app.config import Settings
-    from app.main import create_app
-
-    path = tmp_path / "chain.json"
-    path.write_text(json.dumps(scenario))
-    return TestClient(create_app(Settings(db_path=tmp_path / "chain.db", scenario_path=path)))
 
 
 @pytest.mark.parametrize("pose", [(POSE_TRANS, POSE_ROT), ((300.0, 180.0, -170.0), (9.0, -7.0, -25.0))])
