@@ -134,8 +134,10 @@ class MeasurementLog(Base):
     time: Mapped[str] = mapped_column(String(40))            # UTC ISO 8601
     task: Mapped[str] = mapped_column(String(32))
     target: Mapped[str | None] = mapped_column(String(16))
+    measuring_wo: Mapped[str | None] = mapped_column(String(16))   # WO active while measuring
     status: Mapped[str | None] = mapped_column(String(32))
     probe: Mapped[Any] = mapped_column(NullableJSON, nullable=True)
+    warnings: Mapped[Any] = mapped_column(NullableJSON, nullable=True)
     params: Mapped[Any] = mapped_column(NullableJSON, nullable=True)
     raw: Mapped[Any] = mapped_column(NullableJSON, nullable=True)
     points: Mapped[Any] = mapped_column(NullableJSON, nullable=True)

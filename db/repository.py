@@ -35,7 +35,8 @@ from db.models import (
 CHANNEL = 1
 DEFAULT_PROBE_RECORDS = 3        # _CVAL[0], _CVAL[1]: 3 records each by default
 MAX_EXTRA_SETTABLE = 95          # G505..G599
-LOG_FIELDS = ("task", "params", "raw", "points", "result", "correction", "probe", "target", "status")
+LOG_FIELDS = ("task", "params", "raw", "points", "result", "correction", "probe", "target", "status",
+              "measuring_wo", "warnings")
 TOOL_FIELDS = ("t", "name", "type", "length", "radius", "wear")
 DEFAULT_TOOL = {"name": None, "type": 120, "length": 0.0, "radius": 0.0, "wear": {"length": 0.0, "radius": 0.0}}
 

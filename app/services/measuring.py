@@ -7,6 +7,7 @@ from app.services.machine_service import G500, MachineService, basic_frame_names
 from app.services.settings import SettingsService
 from app.workflow.service import MeasuringContext
 from db import Database
+from db.repository import LOG_FIELDS
 from engine.frames import Frame
 from engine.types import ProbeRecord
 
@@ -85,11 +86,7 @@ class MeasuringEnv:
     def commit_measurement(self, *, offset=None, log_entry: dict, probe_update=None, tool_update=None,
                            tool_probe_update=None) -> int:
         """Offset + audit + log (+ probe/tool records) in one transaction (design.md §6)."""
-        known = {"task", "params", "raw", "points", "result", "correction", "probe", "target", "status"}
-        entry = {k: v for k, v in log_entry.items() if k in known}
-        entry["params"] = {**(entry.get("params") or {}),
-                           "_measuring_wo": log_entry.get("measuring_wo"),
-                           "_warnings": log_entry.get("warnings", [])}
+        entry = {k: v for k, v in log_entry.items() if k in LOG_FIELDS}
         with self._db.unit() as unit:
             if offset is not None:
                 name, _before, after, detail = offset

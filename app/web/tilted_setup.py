@@ -45,7 +45,7 @@ def _log_since(log, since: int) -> list[dict]:
 
 
 def _measuring_wo(entry: dict) -> str | None:
-    return (entry.get("params") or {}).get("_measuring_wo")
+    return entry.get("measuring_wo")
 
 
 def steps_model(services) -> dict:

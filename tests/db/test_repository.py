@@ -232,3 +232,16 @@ def test_a_unit_cannot_be_used_after_its_transaction(db):
         pass
     with pytest.raises(RuntimeError, match="ended"):
         unit.put_offset("G54", FRAME, source="late")
+
+
+def test_log_keeps_the_measuring_wo_and_warnings_as_their_own_fields(tmp_path):
+    from db import Database
+
+    with Database(tmp_path / "log.db") as db:
+        with db.unit() as unit:
+            log_id = unit.add_log({"task": "edge.set", "params": {"axis": "X"}, "target": "G54",
+                                   "measuring_wo": "G500", "warnings": ["Probe not calibrated"]})
+        with db.unit(readonly=True) as unit:
+            entry = unit.get_log(log_id)
+    assert entry["measuring_wo"] == "G500" and entry["warnings"] == ["Probe not calibrated"]
+    assert entry["params"] == {"axis": "X"}          # nothing smuggled into the params any more
