@@ -30,13 +30,7 @@ from .templating import render_screen, vkeys
 
 router = APIRouter()
 URL = "/measure/workpiece/tilted-setup"
-STATE = "tilted_setup"            # {"target": "G54", "since": last log id at the start}
 G500 = "G500"
-
-
-def _state(db) -> dict:
-    with db.unit(readonly=True) as unit:
-        return dict(unit.get_state(STATE, None) or {})
 
 
 def _log_since(log, since: int) -> list[dict]:
@@ -50,7 +44,7 @@ def _measuring_wo(entry: dict) -> str | None:
 
 def steps_model(services) -> dict:
     """The step list with done flags, the open URLs and the resulting WO."""
-    state = _state(services.db)
+    state = support.guided_state(services.db)
     target = state.get("target")
     machine = services.machine
     plane = machine.plane()
@@ -128,10 +122,7 @@ def start(request: Request, target: str = Form("G54")):
     services = request.app.state.services
     if target not in services.offsets.names() or not target.startswith("G5"):
         return _render(request, notice=f"{target!r} is not a settable zero offset")
-    with services.db.unit() as unit:
-        entries = unit.list_log(limit=1)
-        unit.set_state(STATE, {"target": target, "since": entries[0]["id"] if entries else 0})
-        unit.set_state(support.STATE_CHAIN_WO, None)
+    support.start_guided(services.db, target)
     return RedirectResponse(URL, status_code=303)
 
 

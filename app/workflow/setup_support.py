@@ -201,6 +201,23 @@ def carry_out(workflow: WorkflowService, machine, session_id: str, choices: Choi
             "machine": machine.status()}
 
 
+GUIDED_STATE = "tilted_setup"      # guided tilted set-up: {"target": "G54", "since": last log id}
+
+
+def guided_state(db) -> dict:
+    """The guided tilted set-up in progress ({} when none was started)."""
+    with db.unit(readonly=True) as unit:
+        return dict(unit.get_state(GUIDED_STATE, None) or {})
+
+
+def start_guided(db, target: str) -> None:
+    """(Re)start the guided set-up for ``target``: later log entries count; _JM_I[6] reset."""
+    with db.unit() as unit:
+        entries = unit.list_log(limit=1)
+        unit.set_state(GUIDED_STATE, {"target": target, "since": entries[0]["id"] if entries else 0})
+        unit.set_state(STATE_CHAIN_WO, None)
+
+
 def chain_wo(db) -> str | None:
     """``_JM_I[6]``: the WO the last set-up support activated for the next measurement."""
     with db.unit(readonly=True) as unit:
