@@ -6,14 +6,9 @@ arguments of ``WorkflowEnv.commit_measurement`` (offset, probe/tool records).
 
 from __future__ import annotations
 
-import numpy as np
-
 from app.workflow.service import MEASURE_ONLY, MeasureSession, MeasuringContext, points_of
 from engine.correction import correct
 from engine.evaluate import evaluate
-
-ROTATION_TASKS = {"edge.align", "corner.right", "corner.any", "hole.2", "hole.3", "hole.4",
-                  "spigot.2", "spigot.3", "spigot.4", "plane.align"}
 
 
 def setpoints_of(session: MeasureSession, plane_axes: tuple[str, ...]) -> dict[str, float]:
@@ -78,10 +73,6 @@ def finish_workpiece(session: MeasureSession, ctx: MeasuringContext) -> tuple[di
         answer["_activate"] = target
     detail = {"task": session.task, "setpoints": setpoints_of(session, ctx.plane.axes)}
     return answer, {"offset": (target, before_api, after_api, detail)}
-
-
-def as_list(v) -> list[float]:
-    return [float(x) for x in np.asarray(v, float)]
 
 
 FINISHERS = {"workpiece": finish_workpiece}

@@ -12,12 +12,11 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Protocol
 
-import numpy as np
-
 from app.machine.protocol import Machine, MachineAlarm
 from app.workflow.executor import MotionAborted, StepExecutor
 from app.workflow.session import MeasureSession, stored_point_to_api
 from engine.frames import Frame, FrameChain
+from engine.plan import run_program
 from engine.planes import Plane
 from engine.types import MeasuringError, ProbeRecord
 
@@ -282,18 +281,15 @@ class WorkflowService:
         start = executor.current(coords)
         program = self._plan.point_program(session.task, session.params, n, start, plan_ctx)
         raw: list[dict] = []
-        reply = None
-        try:
-            while True:
-                step = program.send(reply)
-                reply = executor.run(step)
-                if reply is not None:
-                    raw.append({"triggered": reply.triggered,
-                                "rec": None if reply.rec is None else [float(v) for v in reply.rec],
-                                "mcs": None if reply.latched_mcs is None
-                                else [float(v) for v in reply.latched_mcs]})
-        except StopIteration as done:
-            return done.value, raw
+
+        def execute(step):
+            latch = executor.run(step)
+            if latch is not None:      # the raw latches go into the log
+                raw.append({"triggered": latch.triggered, "rec": _floats(latch.rec),
+                            "mcs": _floats(latch.latched_mcs)})
+            return latch
+
+        return run_program(program, execute), raw
 
     # --- Calculate ----------------------------------------------------------------------
     def calculate(self, session_id: str) -> dict:
@@ -350,5 +346,5 @@ def points_of(session: MeasureSession) -> list:
     return [s.point for s in session.slots]
 
 
-def vec_dict(v, axes=("X", "Y", "Z")) -> dict[str, float]:
-    return {a: float(x) for a, x in zip(axes, np.asarray(v, float), strict=True)}
+def _floats(v) -> list[float] | None:
+    return None if v is None else [float(x) for x in v]
