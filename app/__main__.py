@@ -1,38 +1,220 @@
-"""``python -m app [--host 127.0.0.1] [--port 8000] [--db PATH] [--scenario PATH]`` (design.md §4)."""
+"""``python -m app [--host 127.0.0.1] [--port 8000] [--db PATH] [--scenario PATH] [--machine sim]
+[--opcua PORT [--opcua-umati]] [--mtconnect PORT]`` (design.md §4, §9.6, §9.7) serves the HMI, with
+``--opcua`` also OPC UA, with ``--mtconnect`` an MTConnect SHDR adapter (docs/opcua.md);
+the access subcommands (design.md §9.2) work on the database:
+
+    python -m app [--db PATH] user add NAME --level L      (password on stdin; switches sign-in on)
+    python -m app [--db PATH] user list | user delete NAME | user passwd NAME
+    python -m app [--db PATH] token add NAME --level L     (prints the new token once)
+    python -m app [--db PATH] token list | token delete NAME
+    python -m app [--db PATH] keyswitch [POSITION]          (show or turn the simulated keyswitch)
+
+Without users the HMI is the stand-alone trainer and binds only to loopback: a ``--host`` other than
+loopback is refused until a user exists.
+"""
 
 from __future__ import annotations
 
 import argparse
+import getpass
+import sys
 from pathlib import Path
 
 from app.config import Settings
+from app.machine import registry
+from db import StorageUnavailable
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
-    parser = argparse.ArgumentParser(prog="python -m app", description="Measure-in-JOG HMI (simulated machine)")
-    parser.add_argument("--host", default=None, help="bind address (default 127.0.0.1)")
+    parser = argparse.ArgumentParser(prog="python -m app", description="Measure-in-JOG HMI (the simulated machine by default)")
+    parser.add_argument("--host", default=None, help="bind address (default 127.0.0.1; another needs a user)")
     parser.add_argument("--port", type=int, default=None, help="TCP port (default 8000)")
     parser.add_argument("--db", type=Path, default=None, help="SQLite file (default data/hmi.db)")
     parser.add_argument("--scenario", type=Path, default=None, help="scenario JSON (default: built-in demo)")
     parser.add_argument("--time-scale", type=float, default=None,
                         help="override the scenario's machine.time_scale (0 = no waiting)")
+    parser.add_argument("--machine", choices=registry.names(), default=None,
+                        help=f"the controller behind the HMI (default {registry.DEFAULT})")
+    parser.add_argument("--trusted-host", action="append", default=None, metavar="NAME",
+                        help="a Host name the HMI answers to besides the loopback names (repeatable)")
+    parser.add_argument("--opcua", type=int, default=None, metavar="PORT",
+                        help="also serve OPC UA at opc.tcp://HOST:PORT (design.md §9.7)")
+    parser.add_argument("--opcua-umati", action="store_true", default=None,
+                        help="with --opcua: add the umati MachineTool instance (loaded in the background)")
+    parser.add_argument("--mtconnect", type=int, default=None, metavar="PORT",
+                        help="also serve an MTConnect SHDR adapter at HOST:PORT for an MTConnect agent")
+    commands = parser.add_subparsers(dest="command", metavar="{user,token,keyswitch}",
+                                     help="access administration (without one: serve the HMI)")
+    user = commands.add_parser("user", help="users who sign in with a password (levels 1-3)")
+    user_cmd = user.add_subparsers(dest="action", required=True)
+    add = user_cmd.add_parser("add", help="create a user; the password is read from stdin")
+    add.add_argument("name")
+    add.add_argument("--level", type=int, required=True, choices=(1, 2, 3),
+                     help="1 manufacturer, 2 service, 3 user")
+    user_cmd.add_parser("list", help="the users and their levels")
+    delete = user_cmd.add_parser("delete", help="remove a user (their sessions end)")
+    delete.add_argument("name")
+    passwd = user_cmd.add_parser("passwd", help="set a new password (from stdin)")
+    passwd.add_argument("name")
+    token = commands.add_parser("token", help="API tokens for automation (Authorization: Bearer)")
+    token_cmd = token.add_subparsers(dest="action", required=True)
+    tadd = token_cmd.add_parser("add", help="create a token and print it once")
+    tadd.add_argument("name")
+    tadd.add_argument("--level", type=int, required=True, choices=range(1, 8), metavar="{1..7}")
+    token_cmd.add_parser("list", help="the tokens and their levels (never the secret)")
+    tdel = token_cmd.add_parser("delete", help="revoke a token")
+    tdel.add_argument("name")
+    key = commands.add_parser("keyswitch", help="show or turn the simulated keyswitch (0..3 = level 7..4)")
+    key.add_argument("position", nargs="?", type=int, choices=(0, 1, 2, 3))
     return parser.parse_args(argv)
 
 
 def settings_from_args(args: argparse.Namespace) -> Settings:
     """Command-line values over ``HMI_*`` environment values over the defaults."""
     given = {"host": args.host, "port": args.port, "db_path": args.db,
-             "scenario_path": args.scenario, "time_scale": args.time_scale}
+             "scenario_path": args.scenario, "time_scale": args.time_scale, "machine": args.machine,
+             "trusted_hosts": getattr(args, "trusted_host", None), "opcua_port": getattr(args, "opcua", None),
+             "opcua_umati": getattr(args, "opcua_umati", None), "mtconnect_port": getattr(args, "mtconnect", None)}
     return Settings(**{k: v for k, v in given.items() if v is not None})
 
 
+def read_password(stdin=None) -> str:
+    """The password from stdin: one line when piped, asked twice on a terminal."""
+    stdin = stdin or sys.stdin
+    if stdin.isatty():
+        first = getpass.getpass("Password: ")
+        if getpass.getpass("Repeat: ") != first:
+            sys.exit("python -m app: the passwords differ")
+        return first
+    return stdin.readline().rstrip("\r\n")
+
+
+def run_access_command(args: argparse.Namespace, settings: Settings) -> int:
+    """``user``/``token``/``keyswitch``; 0 on success. The audit names "cli"."""
+    from app.access.levels import describe_level, keyswitch_level
+    from app.access.service import AccessError, AccessService
+    from db import Actor, Database, acting_as
+
+    with Database(settings.db_path) as db, acting_as(Actor("cli", 0)):
+        access = AccessService(db, settings.session_hours)
+        try:
+            if args.command == "user":
+                if args.action == "add":
+                    user = access.add_user(args.name, args.level, read_password())
+                    print(f"user {user['name']} added with {describe_level(user['level'])}; sign-in is on")
+                elif args.action == "passwd":
+                    access.set_password(args.name, read_password())
+                    print(f"password of {args.name} changed")
+                elif args.action == "delete":
+                    access.delete_user(args.name)
+                    left = access.list_users()
+                    print(f"user {args.name} deleted" + ("" if left else "; no user left: trainer mode (loopback only)"))
+                else:
+                    for user in access.list_users():
+                        print(f"{user['name']}\tlevel {user['level']}\t{user['created']}")
+            elif args.command == "token":
+                if args.action == "add":
+                    secret, record = access.add_token(args.name, args.level)
+                    print(secret)
+                    print(f"token {record['name']} ({describe_level(record['level'])}): shown only now; "
+                          "send it as 'Authorization: Bearer <token>'", file=sys.stderr)
+                elif args.action == "delete":
+                    access.delete_token(args.name)
+                    print(f"token {args.name} revoked")
+                else:
+                    for record in access.list_tokens():
+                        print(f"{record['name']}\tlevel {record['level']}\t{record['created']}")
+            elif args.position is None:
+                position = access.keyswitch()
+                print(f"keyswitch position {position} = level {keyswitch_level(position)}")
+            else:
+                state = access.set_keyswitch(args.position, source="cli")
+                print(f"keyswitch turned to position {state['position']} = level {state['level']}")
+        except AccessError as exc:
+            print(f"python -m app: {exc}", file=sys.stderr)
+            return 1
+    return 0
+
+
+def refuse_open_trainer(settings: Settings) -> str | None:
+    """The message that stops a non-loopback ``--host`` while no user exists, else None."""
+    from app.access.middleware import is_loopback_host
+    from db import Database
+
+    if is_loopback_host(settings.host):
+        return None
+    with Database(settings.db_path) as db, db.unit(readonly=True) as unit:
+        if unit.users_exist():
+            return None
+    return (f"--host {settings.host} would serve the network, but no user is configured: without users the "
+            "HMI is the stand-alone trainer (every function allowed) and serves only this computer. "
+            f"Create a user first: python -m app --db {settings.db_path} user add NAME --level 1")
+
+
+def endpoint_problem(settings: Settings) -> str | None:
+    """A port of the OPC UA endpoint or the MTConnect adapter that cannot be served, as one line
+    (before uvicorn starts)."""
+    chosen = [(flag, port) for flag, port in (("--opcua", settings.opcua_port),
+                                              ("--mtconnect", settings.mtconnect_port)) if port is not None]
+    for flag, port in chosen:
+        if port == settings.port:
+            return f"{flag} {port} is the HTTP port; choose another"
+    if len(chosen) == 2 and chosen[0][1] == chosen[1][1]:
+        return f"--opcua and --mtconnect both ask for port {chosen[0][1]}; choose two"
+    if settings.opcua_port is not None:
+        from app.opcua import port_problem
+
+        problem = port_problem(settings.host, settings.opcua_port)
+        if problem:
+            return problem
+    if settings.mtconnect_port is not None:
+        from app.mtconnect import port_problem as shdr_port_problem
+
+        return shdr_port_problem(settings.host, settings.mtconnect_port)
+    return None
+
+
+def endpoint_lines(settings: Settings) -> list[str]:
+    """Where the shop-floor endpoints listen (docs/opcua.md), one line each."""
+    host = f"[{settings.host}]" if ":" in settings.host else settings.host
+    lines = []
+    if settings.opcua_port is not None:
+        umati = " with the umati MachineTool instance (loading)" if settings.opcua_umati else ""
+        lines.append(f"OPC UA at opc.tcp://{host}:{settings.opcua_port}{umati}, namespace urn:jog-measure-hmi")
+    if settings.mtconnect_port is not None:
+        lines.append(f"MTConnect SHDR adapter at {host}:{settings.mtconnect_port}")
+    return lines
+
+
 def main(argv: list[str] | None = None) -> None:
+    args = parse_args(argv)
+    try:
+        settings = settings_from_args(args)
+        if args.command:
+            sys.exit(run_access_command(args, settings))
+        refusal = refuse_open_trainer(settings)
+    except StorageUnavailable as exc:
+        sys.exit(f"python -m app: {exc}")
+    if refusal:
+        sys.exit(f"python -m app: {refusal}")
+
     import uvicorn
 
-    from app.main import create_app
+    from app.main import create_app, trusted_hosts
 
-    settings = settings_from_args(parse_args(argv))
-    uvicorn.run(create_app(settings), host=settings.host, port=settings.port, log_level="info")
+    try:
+        app = create_app(settings)
+    except (registry.UnknownMachine, StorageUnavailable) as exc:   # a bad HMI_MACHINE; a database
+        sys.exit(f"python -m app: {exc}")                          # that cannot be opened or written
+    problem = endpoint_problem(settings)
+    if problem:
+        sys.exit(f"python -m app: {problem}")
+    for line in endpoint_lines(settings):
+        print(f"python -m app: {line}", file=sys.stderr)
+    if settings.host in ("0.0.0.0", "::"):
+        print(f"python -m app: serving the network; browsers must use one of the trusted host names "
+              f"{', '.join(trusted_hosts(settings))} (add the machine's name with --trusted-host)", file=sys.stderr)
+    uvicorn.run(app, host=settings.host, port=settings.port, log_level="info")
 
 
 if __name__ == "__main__":

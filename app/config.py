@@ -16,3 +16,13 @@ class Settings(BaseSettings):
     db_path: Path = Path("data/hmi.db")
     scenario_path: Path | None = None          # None = the built-in demo scenario
     time_scale: float | None = Field(default=None, ge=0)  # overrides the scenario's machine.time_scale
+    machine: str = "sim"                       # the controller, a name of app.machine.registry (design.md §9.6)
+    # Host names the HMI answers to besides the loopback names (DNS rebinding guard, design.md §9.2);
+    # HMI_TRUSTED_HOSTS='["hmi.plant.local", "10.0.0.5"]' or --trusted-host NAME (repeatable)
+    trusted_hosts: list[str] = Field(default_factory=list)
+    session_hours: float = Field(default=8.0, gt=0, le=24 * 30)   # a sign-in lasts one shift by default
+    # design.md §9.7: also serve OPC UA (opc.tcp://host:PORT) in this process; None = off.
+    # opcua_umati adds the umati MachineTool instance (loaded in the background after the start)
+    opcua_port: int | None = Field(default=None, ge=1, le=65535)
+    opcua_umati: bool = False
+    mtconnect_port: int | None = Field(default=None, ge=1, le=65535)   # an MTConnect SHDR adapter; None = off

@@ -9,13 +9,17 @@ from fastapi import Depends, Request
 from app.services import (
     LogService,
     MachineService,
+    MemoryService,
+    NcService,
     OffsetService,
     ProbeService,
+    ProgramService,
     Services,
     SettingsService,
     ToolProbeService,
     ToolService,
 )
+from app.services.plc import PlcSimulator
 from app.workflow.service import WorkflowService
 
 
@@ -40,4 +44,8 @@ ProbesDep = Annotated[ProbeService, _part("probes")]
 ToolProbesDep = Annotated[ToolProbeService, _part("tool_probes")]
 SettingsDep = Annotated[SettingsService, _part("settings")]
 LogDep = Annotated[LogService, _part("log")]
+MemoriesDep = Annotated[MemoryService, _part("memories")]
 WorkflowDep = Annotated[WorkflowService, _part("workflow")]
+NcDep = Annotated[NcService, _part("nc")]
+ProgramsDep = Annotated[ProgramService, _part("programs")]
+PlcDep = Annotated[PlcSimulator, _part("plc")]

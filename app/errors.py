@@ -13,7 +13,7 @@ from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from app.machine.protocol import MachineAlarm, MachineBusy
-from app.workflow.service import WorkflowError
+from db import StorageUnavailable
 from engine.types import MeasuringError
 
 log = logging.getLogger(__name__)
@@ -48,6 +48,14 @@ class ConflictError(HmiError):
 
 class BusyError(ConflictError):
     code = "busy"
+
+
+class WorkflowError(HmiError):
+    """A request the measuring workflow refuses; ``status`` is the HTTP status to answer with."""
+
+    def __init__(self, status: int, code: str, message: str, field: str | None = None):
+        super().__init__(message, field=field, code=code)
+        self.status = status
 
 
 class AlarmError(ConflictError):
@@ -87,10 +95,6 @@ def install_handlers(app: FastAPI) -> None:
     async def _hmi_error(_: Request, exc: HmiError):
         return error_response(exc.status, exc.code, exc.message, exc.field)
 
-    @app.exception_handler(WorkflowError)
-    async def _workflow_error(_: Request, exc: WorkflowError):
-        return error_response(exc.status, exc.code, exc.message, exc.field)
-
     @app.exception_handler(MeasuringError)
     async def _measuring_error(_: Request, exc: MeasuringError):
         return error_response(409, "alarm", f"{exc.alarm} {exc.message}")
@@ -117,6 +121,11 @@ def install_handlers(app: FastAPI) -> None:
     async def _http_error(_: Request, exc: StarletteHTTPException):
         code = {404: "not_found", 405: "method_not_allowed"}.get(exc.status_code, "http_error")
         return error_response(exc.status_code, code, str(exc.detail))
+
+    @app.exception_handler(StorageUnavailable)
+    async def _storage(_: Request, exc: StorageUnavailable):
+        log.error("storage unavailable: %s", exc)
+        return error_response(503, "storage_unavailable", f"Nothing was stored: {exc}")
 
     @app.exception_handler(ValueError)
     async def _value_error(_: Request, exc: ValueError):

@@ -7,9 +7,9 @@ field here and it appears in the API and on the settings screen (grouped by ``gr
 from __future__ import annotations
 
 import re
-from typing import Literal
+from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 SETTABLE_WO = re.compile(r"^(G500|G5[4-7]|G5(0[5-9]|[1-9][0-9]))$")
 
@@ -19,7 +19,18 @@ def _f(default, gud: str, label: str, group: str, unit: str = "", **constraints)
                  json_schema_extra={"gud": gud, "group": group, "unit": unit}, **constraints)
 
 
-GENERAL, WORKPIECE, TOOL = "General", "Workpiece measuring", "Tool measuring"
+GENERAL, WORKPIECE, TOOL, ACCESS = "General", "Workpiece measuring", "Tool measuring", "Access levels"
+TOLERANCE = "Tool offset from workpiece measuring"
+
+# protection level a function needs (design.md §9.2, app/access/levels.py): 1..7, 0 is nobody's
+AccessLevel = Literal[1, 2, 3, 4, 5, 6, 7]
+
+
+def _level(function: str) -> Any:  # what pydantic's Field returns: the default, as far as mypy knows
+    from app.access.levels import FUNCTIONS
+
+    spec = FUNCTIONS[function]
+    return _f(spec.default, "level", f"{spec.label}: level needed", ACCESS)
 
 
 class GudSettings(BaseModel):
@@ -27,15 +38,18 @@ class GudSettings(BaseModel):
 
     # --- general (_JM_I, _JM_B, _CBIT) -------------------------------------------------------
     plane: Literal["G17", "G18", "G19"] = _f("G17", "_JM_I[3]", "Working plane for measuring", GENERAL)
-    measuring_wo: str = _f("G500", "_JM_I[4]", "WO active during measurement (active = keep)", GENERAL)
+    measuring_wo: str = _f("active", "_JM_I[4]", "WO active during measurement (active = keep)", GENERAL)
     compensation_choice: Literal["standard", "extended"] = _f(
         "standard", "_JM_I[5]", "Compensation choice (extended adds basic frames)", GENERAL)
-    probe_number: int = _f(1, "_JM_I[1]", "Workpiece probe number (_PRNUM)", GENERAL, ge=1, le=199)
+    probe_number: int = _f(1, "_JM_I[1]", "Workpiece probe number", GENERAL, ge=1, le=199)
     tool_probe_number: int = _f(1, "_JM_I[2]", "Tool probe number", GENERAL, ge=1, le=99)
     length_to_tip: bool = _f(False, "_CBIT[14]", "Probe length L1 to the ball end (else centre)", GENERAL)
     override_mismatch: Literal["warn", "refuse"] = _f(
         "warn", "-", "Feed override differs from calibration", GENERAL)
-    inch_display: bool = _f(False, "E_MESS_IS_METRIC", "Display in inch (storage stays mm)", GENERAL)
+    inch_display: bool = _f(False, "E_MESS_IS_METRIC", "Display in inch (storage stays mm)", GENERAL)  # = units
+    pretravel_frame: Literal["probe", "machine"] = _f(
+        "probe", "-", "Probe pre-travel turns with the spindle (probe) or stays with the machine axes",
+        GENERAL)
 
     # --- workpiece measuring -------------------------------------------------------------------
     attempts: Literal[1, 5] = _f(1, "_JM_B[1]", "Measuring attempts", WORKPIECE)
@@ -52,6 +66,8 @@ class GudSettings(BaseModel):
     spigot_safety: float = _f(5.0, "-", "Safety distance around spigots", WORKPIECE, "mm", ge=0, le=100)
     cal_ring_diameter: float = _f(0.0, "E_MESS_CAL_D", "Calibration ring diameter", WORKPIECE, "mm",
                                   ge=0, le=1000)
+    cal_chords: bool = _f(True, "-", "Ring calibration also along off-centre chords (separates eccentricity "
+                          "and pre-travel)", WORKPIECE)
     cal_height: float = _f(0.0, "E_MESS_CAL_L", "Calibration height on the infeed axis (WCS)", WORKPIECE,
                            "mm", ge=-10000, le=10000)
 
@@ -75,6 +91,52 @@ class GudSettings(BaseModel):
     mt_ax: int = _f(133, "E_MESS_MT_AX", "Permitted axis directions (digit code)", TOOL, ge=0, le=333)
     d_l: float = _f(2.0, "E_MESS_D_L", "Measuring path, length (stationary)", TOOL, "mm", gt=0, le=100)
     d_r: float = _f(1.0, "E_MESS_D_R", "Measuring path, radius (stationary)", TOOL, "mm", gt=0, le=100)
+
+    # --- tolerance bands and the mean-value strategy (measuring-math §3.2, design.md §9.3) ----
+    # the defaults of a measurement's params.tolerance (the manual's defaults, jog-measuring §3.2 table)
+    tol_upper: float = _f(1.0, "_TUL", "Upper workpiece tolerance", TOLERANCE, "mm", ge=-1000, le=1000)
+    tol_lower: float = _f(-1.0, "_TLL", "Lower workpiece tolerance", TOLERANCE, "mm", ge=-1000, le=1000)
+    tol_zero_range: float = _f(0.001, "_TZL", "Zero offset range (no correction inside)", TOLERANCE, "mm",
+                               ge=0, le=1000)
+    tol_mean_range: float = _f(0.7, "_TMV", "Mean value range", TOLERANCE, "mm", ge=0, le=1000)
+    tol_dim_difference: float = _f(1.2, "_TDIF", "Dimension difference check", TOLERANCE, "mm", gt=0, le=1000)
+    tol_safe_area: float = _f(2.0, "_TSA", "Safe area", TOLERANCE, "mm", gt=0, le=1000)
+    tol_k: int = _f(1, "_K", "Weighting factor k of the mean value", TOLERANCE, ge=1, le=1000)
+    tol_evnum: int = _f(0, "_EVNUM", "Empirical/mean value memory (0 = none)", TOLERANCE, ge=0, le=999_999)
+    tol_keep_mean: bool = _f(False, "_CHBIT[4]", "Carry the mean value over the parts", TOLERANCE)
+    ev_add: bool = _f(False, "_CHBIT[5]", "Add the empirical value (else subtract)", TOLERANCE)
+    tool_offset_geometry: bool = _f(False, "_CHBIT[6]", "Correct the geometry (else the wear)", TOLERANCE)
+    repeat_on_violation: bool = _f(False, "_CBIT[0]", "Repeat the measurement after a _TSA/_TDIF violation",
+                                   TOLERANCE)
+    # --- access levels: the level each function needs (0 highest .. 7; app/access/levels.py) ----
+    level_view: AccessLevel = _level("view")
+    level_jog: AccessLevel = _level("jog")
+    level_measure: AccessLevel = _level("measure")
+    level_offsets: AccessLevel = _level("offsets")
+    level_tools: AccessLevel = _level("tools")
+    level_probe_data: AccessLevel = _level("probe_data")
+    level_calibration: AccessLevel = _level("calibration")
+    level_settings: AccessLevel = _level("settings")
+    level_keyswitch: AccessLevel = _level("keyswitch")
+    level_scenario: AccessLevel = _level("scenario")
+    level_users: AccessLevel = _level("users")
+    # --- trainer (issue 17 item 10): appended, the General group shows it last ----------------
+    trainer_hide_part: bool = _f(False, "-", "Trainer: hide the real part in the machine view (only what "
+                                 "was measured is drawn)", GENERAL)
+
+    # --- operator screens (design.md §9.9) ------------------------------------------------------
+    language: Literal["auto", "en", "de", "zh"] = _f(
+        "auto", "-", "Language of the screens (auto = the browser's)", GENERAL)
+    units: Literal["mm", "inch"] = _f("mm", "-", "Units of the screens (storage and API stay mm)", GENERAL)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _inch_display_follows_units(cls, data):
+        """``inch_display`` (wave 1) is the old name of ``units == "inch"``: ``units`` rules
+        (``legacy_units`` maps a change of only ``inch_display`` onto it)."""
+        if isinstance(data, dict) and "units" in data:
+            data = {**data, "inch_display": data["units"] == "inch"}
+        return data
 
     @field_validator("measuring_wo")
     @classmethod
@@ -104,10 +166,20 @@ class GudSettings(BaseModel):
         return value
 
 
+def legacy_units(values: dict, current: dict | None = None) -> dict:
+    """``values`` that set ``inch_display`` but not ``units`` set ``units`` from it (wave-1 clients)."""
+    if isinstance(values, dict) and "inch_display" in values and "units" not in values:
+        inch = values["inch_display"]
+        if current is None or inch != current.get("inch_display"):
+            return {**values, "units": "inch" if inch is True else "mm" if inch is False else inch}
+    return values
+
+
 def field_groups() -> list[tuple[str, list[tuple[str, object]]]]:
     """[(group, [(name, FieldInfo), ...])] in declaration order, for the settings screen."""
     groups: dict[str, list] = {}
     for name, info in GudSettings.model_fields.items():
-        extra = info.json_schema_extra or {}
-        groups.setdefault(extra.get("group", GENERAL), []).append((name, info))
+        extra = info.json_schema_extra  # a dict here (_f), a callable is pydantic's other form
+        group = extra.get("group") if isinstance(extra, dict) else None
+        groups.setdefault(group if isinstance(group, str) else GENERAL, []).append((name, info))
     return list(groups.items())

@@ -15,9 +15,9 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from engine.calibration import calibrate_length, calibrate_radius  # noqa: E402
-from engine.evaluate import evaluate  # noqa: E402
 from engine.plan_base import RingCalibrationPoint, RingPass  # noqa: E402
 from engine.planes import PLANES  # noqa: E402
+from engine.tasks import evaluate  # noqa: E402
 from engine.toolmeasure import calibrate_tool_probe, spindle_speed_feeds, tool_length  # noqa: E402
 from engine.types import CirclePoint, EdgePoint, ProbeRecord, RectPoint, Touch  # noqa: E402
 

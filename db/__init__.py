@@ -10,7 +10,8 @@ Usage::
 Imports nothing of ``app`` or ``engine`` (design.md §2).
 """
 
-from db.database import Database
-from db.repository import OffsetSlot, Unit, identity_frame, offset_layout
+from db.database import Database, StorageUnavailable
+from db.repository import Actor, OffsetSlot, Unit, acting_as, current_actor, identity_frame, offset_layout
 
-__all__ = ["Database", "OffsetSlot", "Unit", "identity_frame", "offset_layout"]
+__all__ = ["Actor", "Database", "OffsetSlot", "StorageUnavailable", "Unit", "acting_as", "current_actor", "identity_frame",
+           "offset_layout"]

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import functools
+import sqlite3
+import threading
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
@@ -12,11 +14,18 @@ from alembic.config import Config
 from alembic.runtime.migration import MigrationContext
 from alembic.script import ScriptDirectory
 from sqlalchemy import Connection, Engine, create_engine, event
+from sqlalchemy.exc import DBAPIError, OperationalError
 from sqlalchemy.orm import Session
+from sqlalchemy.pool import ConnectionPoolEntry
 
 from db.repository import Unit, offset_layout, seed_defaults
 
 MIGRATIONS_DIR = Path(__file__).resolve().parent / "migrations"
+
+
+class StorageUnavailable(Exception):
+    """The database cannot be opened or written (disk full, read-only file, gone): nothing of the
+    transaction was stored. ``str()`` names the file and the cause."""
 BUSY_TIMEOUT_MS = 10_000
 
 
@@ -56,18 +65,24 @@ class Database:
         rotary_axes: Sequence[str] = (),
     ):
         self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
         self._layout = offset_layout(extra_settable, basic_frames)
+        self._generation = 0                   # committed write units so far (see ``generation``)
+        self._generation_lock = threading.Lock()
         self._rotary_axes = tuple(rotary_axes)
         # check_same_thread off: the pool hands connections to FastAPI's worker threads.
         self._engine = create_engine(f"sqlite:///{self.path}", connect_args={"check_same_thread": False})
         event.listen(self._engine, "connect", _configure_sqlite_connection)
         event.listen(self._engine, "begin", _begin_transaction)
         self._write_engine = self._engine.execution_options(sqlite_begin="BEGIN IMMEDIATE")
-        with self._write_engine.begin() as connection:
-            upgrade_to_head(connection)
-        with Session(self._write_engine) as session, session.begin():
-            seed_defaults(session, self._layout, self._rotary_axes)
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            with self._write_engine.begin() as connection:
+                upgrade_to_head(connection)
+            with Session(self._write_engine) as session, session.begin():
+                seed_defaults(session, self._layout, self._rotary_axes)
+        except (OSError, DBAPIError) as exc:
+            self._engine.dispose()
+            raise StorageUnavailable(f"cannot open the database {self.path}: {_cause(exc)}") from exc
 
     @contextmanager
     def unit(self, readonly: bool = False) -> Iterator[Unit]:
@@ -81,12 +96,27 @@ class Database:
                 finally:
                     unit.detach()
             return
-        with Session(self._write_engine, expire_on_commit=False) as session, session.begin():
-            unit = Unit(session, self._layout)
-            try:
-                yield unit
-            finally:
-                unit.detach()
+        try:
+            with Session(self._write_engine, expire_on_commit=False) as session, session.begin():
+                unit = Unit(session, self._layout)
+                try:
+                    yield unit
+                finally:
+                    unit.detach()
+                with self._generation_lock:    # before the commit: a reader holding the write
+                    self._generation += 1      # lock never sees a committed change as not made
+        except OperationalError as exc:      # disk full, read-only file, I/O error: rolled back
+            raise StorageUnavailable(f"the database {self.path} cannot be written: {_cause(exc)}") from exc
+
+    @property
+    def generation(self) -> int:
+        """Counts this process's committed writes: a value read while it stays the same is still
+        the stored one (this process is the database's only writer), so it may be cached."""
+        return self._generation
+
+    def offset_names(self) -> list[str]:
+        """The configured frames in chain order (fixed when the database is opened)."""
+        return [slot.name for slot in self._layout]
 
     @property
     def engine(self) -> Engine:
@@ -103,7 +133,13 @@ class Database:
         self.close()
 
 
-def _configure_sqlite_connection(dbapi_connection, _connection_record) -> None:
+def _cause(exc: Exception) -> str:
+    """The driver's own words (e.g. "database or disk is full"), without SQL and parameters."""
+    original = getattr(exc, "orig", None) or exc
+    return str(original).splitlines()[0] if str(original) else type(original).__name__
+
+
+def _configure_sqlite_connection(dbapi_connection: sqlite3.Connection, _connection_record: ConnectionPoolEntry) -> None:
     # Take transaction control from pysqlite: SQLAlchemy's "begin" event emits BEGIN itself.
     dbapi_connection.isolation_level = None
     cursor = dbapi_connection.cursor()

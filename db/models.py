@@ -6,9 +6,9 @@ The initial migration (``migrations/versions/0001_initial.py``) creates exactly 
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from sqlalchemy import JSON, CheckConstraint, Float, Index, Integer, String, UniqueConstraint
+from sqlalchemy import JSON, CheckConstraint, Float, ForeignKey, Index, Integer, String, UniqueConstraint
 from sqlalchemy.orm import DeclarativeBase, Mapped, declared_attr, mapped_column
 
 GEOMETRY_AXES = ("X", "Y", "Z")
@@ -52,19 +52,71 @@ class FrameAxis(Base):
     scale: Mapped[float] = mapped_column(Float, default=1.0)
 
 
+# what an audit row records (``OffsetAudit.kind``); ``offset`` names the item of that kind
+AUDIT_KINDS = ("offset", "memory", "tool", "probe", "tool_probe", "settings", "scenario", "user", "token",
+               "keyswitch")
+MIN_LEVEL, MAX_LEVEL = 0, 7          # SINUMERIK protection levels: 0 highest .. 7 lowest
+PASSWORD_LEVELS = (1, 2, 3)          # a user's password gives one of these (keyswitch: 4..7)
+
+
 class OffsetAudit(Base):
-    """Every zero-offset change: before/after frame, who (source), when, and why (detail)."""
+    """Every change of stored data: before/after, who (user or token, and its access level at the
+    time), through what (source: api/screen/measure/...), when, and why (detail). Zero offsets
+    (kind "offset") since 0001; memories, tools, probe records, settings, users, ... since 0004."""
 
     __tablename__ = "offset_audit"
-    __table_args__ = (Index("ix_offset_audit_offset_id", "offset", "id"),)
+    __table_args__ = (Index("ix_offset_audit_offset_id", "offset", "id"),
+                      Index("ix_offset_audit_kind_id", "kind", "id"))
 
     id: Mapped[int] = mapped_column(primary_key=True)
     time: Mapped[str] = mapped_column(String(40))            # UTC ISO 8601
-    offset: Mapped[str] = mapped_column(String(16))
-    before: Mapped[dict[str, Any]] = mapped_column(JSON)
-    after: Mapped[dict[str, Any]] = mapped_column(JSON)
+    offset: Mapped[str] = mapped_column(String(16))          # the item: G54, EV10, T9, WP1, settings ...
+    before: Mapped[Any] = mapped_column(NullableJSON, nullable=True)   # None: the item did not exist
+    after: Mapped[Any] = mapped_column(NullableJSON, nullable=True)    # None: the item was deleted
     source: Mapped[str] = mapped_column(String(64))
     detail: Mapped[dict[str, Any] | None] = mapped_column(NullableJSON)
+    kind: Mapped[str] = mapped_column(String(16), default="offset", server_default="offset")
+    who: Mapped[str | None] = mapped_column(String(80))      # "user:anna", "token:mes", "trainer", ...
+    who_level: Mapped[int | None] = mapped_column(Integer)
+
+
+class User(Base):
+    """A person who signs in with a password; the password gives a protection level 1..3."""
+
+    __tablename__ = "users"
+    __table_args__ = (CheckConstraint("level BETWEEN 1 AND 3", name="ck_users_level"),)
+
+    id: Mapped[int] = mapped_column(primary_key=True)
+    name: Mapped[str] = mapped_column(String(64), unique=True)
+    level: Mapped[int] = mapped_column(Integer)
+    password_hash: Mapped[str] = mapped_column(String(255))   # argon2id (pwdlib), never the password
+    created: Mapped[str] = mapped_column(String(40))
+
+
+class ApiToken(Base):
+    """An automation credential (``Authorization: Bearer``) with its own level; stored as a SHA-256
+    of a 256-bit random secret (shown once by ``python -m app token add``)."""
+
+    __tablename__ = "api_tokens"
+    __table_args__ = (CheckConstraint("level BETWEEN 1 AND 7", name="ck_api_tokens_level"),)
+
+    id: Mapped[int] = mapped_column(primary_key=True)
+    name: Mapped[str] = mapped_column(String(64), unique=True)
+    level: Mapped[int] = mapped_column(Integer)
+    token_hash: Mapped[str] = mapped_column(String(64), unique=True)
+    created: Mapped[str] = mapped_column(String(40))
+
+
+class AuthSession(Base):
+    """A signed-in browser: the cookie holds a random secret, this row its SHA-256. ``user_id`` NULL
+    is the operator panel (its level is the keyswitch's, read on every request)."""
+
+    __tablename__ = "auth_sessions"
+
+    id: Mapped[str] = mapped_column(String(64), primary_key=True)
+    user_id: Mapped[int | None] = mapped_column(ForeignKey("users.id", ondelete="CASCADE"))
+    created: Mapped[str] = mapped_column(String(40))
+    expires: Mapped[str] = mapped_column(String(40))
 
 
 class Tool(Base):
@@ -80,6 +132,8 @@ class Tool(Base):
     radius: Mapped[float] = mapped_column(Float, default=0.0)
     wear_length: Mapped[float] = mapped_column(Float, default=0.0)
     wear_radius: Mapped[float] = mapped_column(Float, default=0.0)
+    # lathe tools (turning.md §10.2): {"sl", "l1", "l2", "wear_l1", "wear_l2"}; NULL for milling tools
+    lathe: Mapped[dict[str, Any] | None] = mapped_column(NullableJSON, nullable=True)
 
 
 class _ProbeRecord:
@@ -88,9 +142,11 @@ class _ProbeRecord:
     number: Mapped[int] = mapped_column(Integer, primary_key=True, autoincrement=False)
     calibrated_at: Mapped[str | None] = mapped_column(String(40))
     data: Mapped[dict[str, Any]] = mapped_column(JSON)
+    if TYPE_CHECKING:
+        __tablename__: str              # set by each mapped subclass
 
     @declared_attr.directive
-    def __table_args__(cls) -> tuple:
+    def __table_args__(cls) -> tuple[CheckConstraint]:
         return (CheckConstraint(f"number BETWEEN 1 AND {MAX_PROBE_NUMBER}",
                                 name=f"ck_{cls.__tablename__}_number"),)
 
@@ -124,6 +180,20 @@ class MachineState(_KeyValue, Base):
     __tablename__ = "machine_state"
 
 
+class MemoryValue(Base):
+    """Empirical value (EV) and mean value (MV) memories _EV[n-1], _MV[n-1] (measuring-math §3.3)."""
+
+    __tablename__ = "memory_values"
+    __table_args__ = (
+        CheckConstraint("kind IN ('EV', 'MV')", name="ck_memory_values_kind"),
+        CheckConstraint("number >= 1", name="ck_memory_values_number"),
+    )
+
+    kind: Mapped[str] = mapped_column(String(2), primary_key=True)
+    number: Mapped[int] = mapped_column(Integer, primary_key=True)     # memory number n = index + 1
+    value: Mapped[float] = mapped_column(Float)
+
+
 class MeasurementLog(Base):
     """One measurement: task, params, raw touches, stored points, result and correction."""
 
@@ -143,3 +213,16 @@ class MeasurementLog(Base):
     points: Mapped[Any] = mapped_column(NullableJSON, nullable=True)
     result: Mapped[Any] = mapped_column(NullableJSON, nullable=True)
     correction: Mapped[Any] = mapped_column(NullableJSON, nullable=True)
+    program: Mapped[str | None] = mapped_column(String(64), nullable=True)   # part program (NC cycle), else None
+    block: Mapped[str | None] = mapped_column(String(200), nullable=True)    # the block that called the cycle
+
+
+class Program(Base):
+    """A stored part program (design.md §9.4): name, NC text, when it was last written."""
+
+    __tablename__ = "programs"
+
+    name: Mapped[str] = mapped_column(String(32), primary_key=True)
+    text: Mapped[str] = mapped_column(String)
+    created_at: Mapped[str] = mapped_column(String(40))      # UTC ISO 8601
+    updated_at: Mapped[str] = mapped_column(String(40))

@@ -9,12 +9,14 @@ from __future__ import annotations
 import copy
 import json
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass
 from datetime import UTC, datetime
-from typing import Any
+from typing import Any, TypeVar
 
-from sqlalchemy import select
+from sqlalchemy import Row, delete, exists, func, select
 from sqlalchemy.orm import Session
 
 from db.models import (
@@ -22,23 +24,63 @@ from db.models import (
     GEOMETRY_AXES,
     MAX_PROBE_NUMBER,
     ROTARY_AXES,
+    ApiToken,
+    AuthSession,
     FrameAxis,
     MachineState,
     MeasurementLog,
+    MemoryValue,
     OffsetAudit,
     Probe,
+    Program,
     Setting,
     Tool,
     ToolProbe,
+    User,
 )
 
 CHANNEL = 1
 DEFAULT_PROBE_RECORDS = 3        # _CVAL[0], _CVAL[1]: 3 records each by default
 MAX_EXTRA_SETTABLE = 95          # G505..G599
 LOG_FIELDS = ("task", "params", "raw", "points", "result", "correction", "probe", "target", "status",
-              "measuring_wo", "warnings")
-TOOL_FIELDS = ("t", "name", "type", "length", "radius", "wear")
-DEFAULT_TOOL = {"name": None, "type": 120, "length": 0.0, "radius": 0.0, "wear": {"length": 0.0, "radius": 0.0}}
+              "measuring_wo", "warnings", "program", "block")
+PROGRAM_TEXT_MAX = 200_000       # characters of one part program
+TOOL_FIELDS = ("t", "name", "type", "length", "radius", "wear", "sl", "l1", "l2")
+LATHE_TOOL_FIELDS = ("sl", "l1", "l2")          # lathe tools only (turning.md §10.2); None = not a lathe value
+_Record = TypeVar("_Record", Probe, ToolProbe)              # the numbered JSON records
+_KeyValue = TypeVar("_KeyValue", Setting, MachineState)      # the key -> JSON value tables
+
+DEFAULT_TOOL: dict[str, Any] = {"name": None, "type": 120, "length": 0.0, "radius": 0.0, "wear": {"length": 0.0, "radius": 0.0}}
+
+
+@dataclass(frozen=True)
+class Actor:
+    """Who writes: ``who`` as the audit shows it ("user:anna", "token:mes", "trainer", "panel",
+    "cli") and the protection level it acted with (0 highest .. 7)."""
+
+    who: str
+    level: int | None = None
+
+
+# The acting identity of the current request (or command): the app sets it per request; every
+# audit row a unit writes names it. A ContextVar reaches the threads FastAPI runs endpoints in;
+# code that starts its own thread carries it over with ``contextvars.copy_context()``.
+_ACTOR: ContextVar[Actor | None] = ContextVar("hmi_actor", default=None)
+SYSTEM = Actor("system")      # writes nobody asked for (seeding, start-up scenario)
+
+
+def current_actor() -> Actor | None:
+    return _ACTOR.get()
+
+
+@contextmanager
+def acting_as(actor: Actor | None) -> Iterator[None]:
+    """Audit rows written inside the block name ``actor``."""
+    token = _ACTOR.set(actor)
+    try:
+        yield
+    finally:
+        _ACTOR.reset(token)
 
 
 @dataclass(frozen=True)
@@ -62,7 +104,7 @@ def offset_layout(extra_settable: int, basic_frames: int) -> tuple[OffsetSlot, .
     return (OffsetSlot("BASIC_REF", "setframe", 0), *basic, *settable)
 
 
-def identity_frame(rotary_axes: Iterable[str] = ()) -> dict:
+def identity_frame(rotary_axes: Iterable[str] = ()) -> dict[str, Any]:
     return {
         "trans": {axis: 0.0 for axis in (*GEOMETRY_AXES, *rotary_axes)},
         "fine": dict.fromkeys(GEOMETRY_AXES, 0.0),
@@ -99,26 +141,32 @@ class Unit:
         """Called when the transaction ends: later use fails loudly instead of writing nowhere."""
         self._session = _EndedTransaction()  # type: ignore[assignment]
 
+    def hold_write_lock(self) -> None:
+        """Start the transaction now (a writing unit takes SQLite's write lock at BEGIN)."""
+        self._session.connection()
+
     # --- zero offsets / frames ---------------------------------------------------------
 
     def offset_names(self) -> list[str]:
         return list(self._slots)
 
-    def list_offsets(self) -> dict[str, dict]:
-        rows = self._session.scalars(
-            select(FrameAxis).where(FrameAxis.channel == CHANNEL, FrameAxis.name.in_(self._slots))
+    def list_offsets(self) -> dict[str, dict[str, Any]]:
+        # columns, not ORM objects: every measurement reads all frames (several times)
+        rows = self._session.execute(
+            select(FrameAxis.name, FrameAxis.axis, FrameAxis.coarse, FrameAxis.fine, FrameAxis.rot)
+            .where(FrameAxis.channel == CHANNEL, FrameAxis.name.in_(self._slots))
         )
-        by_name: dict[str, list[FrameAxis]] = {name: [] for name in self._slots}
+        by_name: dict[str, list[Row[str, str, float, float, float | None]]] = {name: [] for name in self._slots}
         for row in rows:
             by_name[row.name].append(row)
         return {name: _frame_from_rows(axis_rows) for name, axis_rows in by_name.items()}
 
-    def get_offset(self, name: str) -> dict | None:
+    def get_offset(self, name: str) -> dict[str, Any] | None:
         if name not in self._slots:
             return None
         return _frame_from_rows(self._frame_rows(name).values())
 
-    def put_offset(self, name: str, frame: dict, source: str, detail: dict | None = None) -> tuple[dict, dict]:
+    def put_offset(self, name: str, frame: dict[str, Any], source: str, detail: dict[str, Any] | None = None) -> tuple[dict[str, Any], dict[str, Any]]:
         """Replaces the whole frame (components not given become 0) and records the change.
 
         Returns (before, after). KeyError for a name that is not a configured offset,
@@ -139,23 +187,37 @@ class Unit:
                 self._session.add(row)
             row.coarse, row.fine, row.rot = values.get(axis, (0.0, 0.0, 0.0 if axis in GEOMETRY_AXES else None))
         after = _frame_from_rows(rows.values())
-        self._session.add(OffsetAudit(
-            time=_utc_now(), offset=name, before=before, after=after, source=str(source),
-            detail=_json_ready(detail, "detail"),
-        ))
-        self._session.flush()
+        self.add_audit("offset", name, before, after, source, detail)
         return copy.deepcopy(before), copy.deepcopy(after)
 
-    def audit(self, limit: int = 200, name: str | None = None) -> list[dict]:
-        """Offset changes, newest first."""
+    # --- audit trail -----------------------------------------------------------------------
+
+    def add_audit(self, kind: str, name: str, before: Any, after: Any, source: str,
+                  detail: dict[str, Any] | None = None) -> int:
+        """One audit row naming the acting identity (``current_actor()``, else "system")."""
+        actor = current_actor() or SYSTEM
+        row = OffsetAudit(time=_utc_now(), kind=kind, offset=str(name), before=_json_ready(before, "before"),
+                          after=_json_ready(after, "after"), source=str(source),
+                          detail=_json_ready(detail, "detail"), who=actor.who[:80], who_level=actor.level)
+        self._session.add(row)
+        self._session.flush()
+        return row.id
+
+    def audit(self, limit: int = 200, name: str | None = None, kind: str | None = None,
+              before_id: int | None = None) -> list[dict[str, Any]]:
+        """Audit rows, newest first (``name``: one item, e.g. G54; ``kind``: one kind of data)."""
         query = select(OffsetAudit).order_by(OffsetAudit.id.desc()).limit(limit)
         if name is not None:
             query = query.where(OffsetAudit.offset == name)
-        return [
-            copy.deepcopy({"id": row.id, "time": row.time, "offset": row.offset, "before": row.before,
-                           "after": row.after, "source": row.source, "detail": row.detail})
-            for row in self._session.scalars(query)
-        ]
+        if kind is not None:
+            query = query.where(OffsetAudit.kind == kind)
+        if before_id is not None:
+            query = query.where(OffsetAudit.id < before_id)
+        return [_audit_dict(row) for row in self._session.scalars(query)]
+
+    def get_audit(self, audit_id: int) -> dict[str, Any] | None:
+        row = self._session.get(OffsetAudit, audit_id)
+        return None if row is None else _audit_dict(row)
 
     def _frame_rows(self, name: str) -> dict[str, FrameAxis]:
         rows = self._session.scalars(
@@ -165,23 +227,25 @@ class Unit:
 
     # --- tools ---------------------------------------------------------------------------
 
-    def list_tools(self) -> list[dict]:
+    def list_tools(self) -> list[dict[str, Any]]:
         return [_tool_dict(row) for row in self._session.scalars(select(Tool).order_by(Tool.t))]
 
-    def get_tool(self, t: int) -> dict | None:
+    def get_tool(self, t: int) -> dict[str, Any] | None:
         row = self._session.get(Tool, t)
         return None if row is None else _tool_dict(row)
 
-    def put_tool(self, t: int, data: dict) -> dict:
-        """Creates or updates tool ``t``; fields not given keep their value (or the default)."""
+    def put_tool(self, t: int, data: dict[str, Any], source: str | None = None, detail: dict[str, Any] | None = None) -> dict[str, Any]:
+        """Creates or updates tool ``t``; fields not given keep their value (or the default).
+        With ``source`` the change is audited (kind "tool", item "T<t>")."""
         t = _positive_int(t, "t")
+        before = self.get_tool(t)
         _check_keys(data, TOOL_FIELDS, "tool")
         if "t" in data and data["t"] != t:
             raise ValueError(f"tool data says t={data['t']!r} but is stored as T{t}")
         row = self._session.get(Tool, t)
         current = DEFAULT_TOOL if row is None else _tool_dict(row)
         wear = data.get("wear", {})
-        _check_keys(wear, ("length", "radius"), "tool wear")
+        _check_keys(wear, ("length", "radius", "l1", "l2"), "tool wear")
         name = data.get("name", current["name"])
         if name is not None and not isinstance(name, str):
             raise ValueError("tool name must be a string or null")
@@ -194,42 +258,52 @@ class Unit:
         row.radius = _finite(data.get("radius", current["radius"]), "radius")
         row.wear_length = _finite(wear.get("length", current["wear"]["length"]), "wear.length")
         row.wear_radius = _finite(wear.get("radius", current["wear"]["radius"]), "wear.radius")
+        row.lathe = _lathe_fields(data, wear, row.lathe)
         self._session.flush()
-        return _tool_dict(row)
+        after = _tool_dict(row)
+        if source is not None:
+            self.add_audit("tool", f"T{t}", before, after, source, detail)
+        return after
 
-    def delete_tool(self, t: int) -> None:
-        """KeyError when there is no tool ``t``."""
+    def delete_tool(self, t: int, source: str | None = None) -> None:
+        """KeyError when there is no tool ``t``; with ``source`` audited."""
         row = self._session.get(Tool, t)
         if row is None:
             raise KeyError(t)
+        before = _tool_dict(row)
         self._session.delete(row)
         self._session.flush()
+        if source is not None:
+            self.add_audit("tool", f"T{t}", before, None, source)
 
     # --- workpiece probe (_WP) and tool probe (_TP) records ------------------------------
 
-    def get_probe(self, n: int) -> dict | None:
+    def get_probe(self, n: int) -> dict[str, Any] | None:
         return self._get_record(Probe, n)
 
-    def put_probe(self, n: int, data: dict) -> dict:
-        return self._put_record(Probe, n, data)
+    def put_probe(self, n: int, data: dict[str, Any], source: str | None = None, detail: dict[str, Any] | None = None) -> dict[str, Any]:
+        """With ``source`` audited (kind "probe", item "WP<n>")."""
+        return self._put_record(Probe, n, data, source, detail)
 
-    def list_probes(self) -> list[dict]:
+    def list_probes(self) -> list[dict[str, Any]]:
         return self._list_records(Probe)
 
-    def get_tool_probe(self, n: int) -> dict | None:
+    def get_tool_probe(self, n: int) -> dict[str, Any] | None:
         return self._get_record(ToolProbe, n)
 
-    def put_tool_probe(self, n: int, data: dict) -> dict:
-        return self._put_record(ToolProbe, n, data)
+    def put_tool_probe(self, n: int, data: dict[str, Any], source: str | None = None, detail: dict[str, Any] | None = None) -> dict[str, Any]:
+        """With ``source`` audited (kind "tool_probe", item "TP<n>")."""
+        return self._put_record(ToolProbe, n, data, source, detail)
 
-    def list_tool_probes(self) -> list[dict]:
+    def list_tool_probes(self) -> list[dict[str, Any]]:
         return self._list_records(ToolProbe)
 
-    def _get_record(self, model: type[Probe] | type[ToolProbe], n: int) -> dict | None:
+    def _get_record(self, model: type[_Record], n: int) -> dict[str, Any] | None:
         row = self._session.get(model, n)
         return None if row is None else copy.deepcopy(row.data)
 
-    def _put_record(self, model: type[Probe] | type[ToolProbe], n: int, data: dict) -> dict:
+    def _put_record(self, model: type[_Record], n: int, data: dict[str, Any],
+                    source: str | None = None, detail: dict[str, Any] | None = None) -> dict[str, Any]:
         """Replaces the record's document; ``number`` is set to n, ``calibrated_at`` indexed."""
         n = _positive_int(n, "probe number")
         if n > MAX_PROBE_NUMBER:
@@ -241,23 +315,27 @@ class Unit:
         if calibrated_at is not None and not isinstance(calibrated_at, str):
             raise ValueError("calibrated_at must be an ISO time string or null")
         row = self._session.get(model, n)
+        before = None if row is None else copy.deepcopy(row.data)
         if row is None:
             row = model(number=n)
             self._session.add(row)
         row.data, row.calibrated_at = document, calibrated_at
         self._session.flush()
+        if source is not None:
+            kind, prefix = ("probe", "WP") if model is Probe else ("tool_probe", "TP")
+            self.add_audit(kind, f"{prefix}{n}", before, document, source, detail)
         return copy.deepcopy(document)
 
-    def _list_records(self, model: type[Probe] | type[ToolProbe]) -> list[dict]:
+    def _list_records(self, model: type[_Record]) -> list[dict[str, Any]]:
         return [copy.deepcopy(row.data) for row in self._session.scalars(select(model).order_by(model.number))]
 
     # --- settings and machine state (key -> JSON value) ---------------------------------
 
-    def get_settings(self) -> dict:
+    def get_settings(self) -> dict[str, Any]:
         rows = self._session.scalars(select(Setting).order_by(Setting.key))
         return {row.key: copy.deepcopy(row.value) for row in rows}
 
-    def put_settings(self, values: dict) -> dict:
+    def put_settings(self, values: dict[str, Any]) -> dict[str, Any]:
         """Merges ``values`` into the stored settings; returns all settings."""
         if not isinstance(values, dict) or not all(isinstance(key, str) for key in values):
             raise ValueError("settings must be an object with string keys")
@@ -274,7 +352,7 @@ class Unit:
         self._upsert(MachineState, key, value)
         self._session.flush()
 
-    def _upsert(self, model: type[Setting] | type[MachineState], key: str, value: Any) -> None:
+    def _upsert(self, model: type[_KeyValue], key: str, value: Any) -> None:
         value = _json_ready(value, key)
         row = self._session.get(model, key)
         if row is None:
@@ -282,9 +360,74 @@ class Unit:
         else:
             row.value = value
 
+    # --- EV / MV memories (measuring-math §3.3) ----------------------------------------------
+
+    def get_memory(self, kind: str, number: int) -> float:
+        """The memory's value; 0 for one never written (the NC's initial value)."""
+        row = self._session.get(MemoryValue, (_memory_kind(kind), _positive_int(number, "memory number")))
+        return 0.0 if row is None else float(row.value)
+
+    def list_memories(self, kind: str) -> dict[int, float]:
+        rows = self._session.scalars(select(MemoryValue).where(MemoryValue.kind == _memory_kind(kind))
+                                     .order_by(MemoryValue.number))
+        return {row.number: float(row.value) for row in rows}
+
+    def put_memory(self, kind: str, number: int, value: float, source: str, detail: dict[str, Any] | None = None
+                   ) -> tuple[float, float]:
+        """Writes the memory and an audit row (offset name "EV10", "MV10"); (before, after)."""
+        kind, number = _memory_kind(kind), _positive_int(number, "memory number")
+        value = _finite(value, f"{kind}{number}")
+        row = self._session.get(MemoryValue, (kind, number))
+        before = 0.0 if row is None else float(row.value)
+        if row is None:
+            self._session.add(MemoryValue(kind=kind, number=number, value=value))
+        else:
+            row.value = value
+        self.add_audit("memory", f"{kind}{number}", {"value": before}, {"value": value}, source, detail)
+        return before, value
+
+    # --- part programs (design.md §9.4) -------------------------------------------------
+
+    def list_programs(self) -> list[dict[str, Any]]:
+        """Every stored program without its text: name, size (characters, lines), times."""
+        rows = self._session.execute(select(Program.name, func.length(Program.text), Program.text,
+                                            Program.created_at, Program.updated_at).order_by(Program.name))
+        return [{"name": name, "size": int(size or 0), "lines": text.count("\n") + (1 if text and not
+                 text.endswith("\n") else 0), "created_at": created, "updated_at": updated}
+                for name, size, text, created, updated in rows]
+
+    def get_program(self, name: str) -> dict[str, Any] | None:
+        row = self._session.get(Program, name)
+        return None if row is None else _program_dict(row)
+
+    def put_program(self, name: str, text: str) -> tuple[dict[str, Any], bool]:
+        """Creates or replaces program ``name``; (program, created)."""
+        if not isinstance(name, str) or not name:
+            raise ValueError("a program needs a name")
+        if not isinstance(text, str) or len(text) > PROGRAM_TEXT_MAX:
+            raise ValueError(f"a program is a text of at most {PROGRAM_TEXT_MAX} characters")
+        now = _utc_now()
+        row = self._session.get(Program, name)
+        created = row is None
+        if row is None:
+            row = Program(name=name, text=text, created_at=now, updated_at=now)
+            self._session.add(row)
+        else:
+            row.text, row.updated_at = text, now
+        self._session.flush()
+        return _program_dict(row), created
+
+    def delete_program(self, name: str) -> None:
+        """KeyError when there is no program ``name``."""
+        row = self._session.get(Program, name)
+        if row is None:
+            raise KeyError(name)
+        self._session.delete(row)
+        self._session.flush()
+
     # --- measurement log -----------------------------------------------------------------
 
-    def add_log(self, entry: dict) -> int:
+    def add_log(self, entry: dict[str, Any]) -> int:
         _check_keys(entry, LOG_FIELDS, "log entry")
         if not isinstance(entry.get("task"), str):
             raise ValueError("log entry needs a task name")
@@ -293,14 +436,120 @@ class Unit:
         self._session.flush()
         return row.id
 
-    def list_log(self, limit: int = 500) -> list[dict]:
-        """Newest first."""
-        query = select(MeasurementLog).order_by(MeasurementLog.id.desc()).limit(limit)
-        return [_log_dict(row) for row in self._session.scalars(query)]
+    def list_log(self, limit: int = 500, offset: int = 0, before_id: int | None = None,
+                 fields: Iterable[str] | None = None) -> list[dict[str, Any]]:
+        """Newest first: ``limit`` entries after skipping ``offset`` (or those older than
+        ``before_id``, for paging through all of them); ``fields`` reads only those columns."""
+        names = LOG_FIELDS if fields is None else tuple(f for f in LOG_FIELDS if f in set(fields))
+        columns = [MeasurementLog.id, MeasurementLog.time, *(getattr(MeasurementLog, f) for f in names)]
+        query = select(*columns).order_by(MeasurementLog.id.desc())
+        if before_id is not None:
+            query = query.where(MeasurementLog.id < before_id)
+        query = query.offset(offset).limit(limit)
+        return [{"id": row[0], "time": row[1], **dict(zip(names, row[2:], strict=True))}
+                for row in self._session.execute(query)]
 
-    def get_log(self, log_id: int) -> dict | None:
+    def count_log(self) -> int:
+        return int(self._session.scalar(select(func.count(MeasurementLog.id))) or 0)
+
+    def get_log(self, log_id: int) -> dict[str, Any] | None:
         row = self._session.get(MeasurementLog, log_id)
         return None if row is None else _log_dict(row)
+
+
+    # --- users, API tokens, sign-in sessions (access levels, design.md §9.2) ---------------
+
+    def users_exist(self) -> bool:
+        return bool(self._session.scalar(select(exists().where(User.id.is_not(None)))))
+
+    def list_users(self) -> list[dict[str, Any]]:
+        return [_user_dict(row) for row in self._session.scalars(select(User).order_by(User.name))]
+
+    def get_user(self, name: str, with_hash: bool = False) -> dict[str, Any] | None:
+        row = self._session.scalar(select(User).where(User.name == name))
+        if row is None:
+            return None
+        return {**_user_dict(row), "password_hash": row.password_hash} if with_hash else _user_dict(row)
+
+    def add_user(self, name: str, level: int, password_hash: str) -> dict[str, Any]:
+        """ValueError when the name is taken."""
+        if self.get_user(name) is not None:
+            raise ValueError(f"user {name!r} exists already")
+        row = User(name=name, level=level, password_hash=password_hash, created=_utc_now())
+        self._session.add(row)
+        self._session.flush()
+        return _user_dict(row)
+
+    def set_password_hash(self, name: str, password_hash: str) -> None:
+        row = self._session.scalar(select(User).where(User.name == name))
+        if row is None:
+            raise KeyError(name)
+        row.password_hash = password_hash
+        self._session.flush()
+
+    def delete_user(self, name: str) -> dict[str, Any]:
+        """KeyError when there is no such user; the user's sessions end with it."""
+        row = self._session.scalar(select(User).where(User.name == name))
+        if row is None:
+            raise KeyError(name)
+        data = _user_dict(row)
+        self._session.execute(delete(AuthSession).where(AuthSession.user_id == row.id))
+        self._session.delete(row)
+        self._session.flush()
+        return data
+
+    def list_tokens(self) -> list[dict[str, Any]]:
+        return [_token_dict(row) for row in self._session.scalars(select(ApiToken).order_by(ApiToken.name))]
+
+    def add_token(self, name: str, level: int, token_hash: str) -> dict[str, Any]:
+        if self._session.scalar(select(ApiToken).where(ApiToken.name == name)) is not None:
+            raise ValueError(f"token {name!r} exists already")
+        row = ApiToken(name=name, level=level, token_hash=token_hash, created=_utc_now())
+        self._session.add(row)
+        self._session.flush()
+        return _token_dict(row)
+
+    def token_by_hash(self, token_hash: str) -> dict[str, Any] | None:
+        row = self._session.scalar(select(ApiToken).where(ApiToken.token_hash == token_hash))
+        return None if row is None else _token_dict(row)
+
+    def delete_token(self, name: str) -> dict[str, Any]:
+        row = self._session.scalar(select(ApiToken).where(ApiToken.name == name))
+        if row is None:
+            raise KeyError(name)
+        data = _token_dict(row)
+        self._session.delete(row)
+        self._session.flush()
+        return data
+
+    def add_session(self, session_hash: str, user_name: str | None, expires: str) -> None:
+        """A sign-in: ``user_name`` None is the operator panel (keyswitch level)."""
+        now = _utc_now()
+        self._session.execute(delete(AuthSession).where(AuthSession.expires < now))
+        user_id = None
+        if user_name is not None:
+            user_id = self._session.scalar(select(User.id).where(User.name == user_name))
+            if user_id is None:
+                raise KeyError(user_name)
+        self._session.add(AuthSession(id=session_hash, user_id=user_id, created=now, expires=expires))
+        self._session.flush()
+
+    def get_session(self, session_hash: str) -> dict[str, Any] | None:
+        """{"user": {...} or None (panel), "expires"} of a session that has not expired."""
+        row = self._session.get(AuthSession, session_hash)
+        if row is None or row.expires < _utc_now():
+            return None
+        user = None
+        if row.user_id is not None:
+            user_row = self._session.get(User, row.user_id)
+            if user_row is None:
+                return None
+            user = _user_dict(user_row)
+        return {"user": user, "expires": row.expires, "created": row.created}
+
+    def delete_session(self, session_hash: str) -> None:
+        self._session.execute(delete(AuthSession).where(AuthSession.id == session_hash))
+        self._session.flush()
 
 
 class _EndedTransaction:
@@ -317,7 +566,7 @@ def _new_frame_axis(slot: OffsetSlot, axis: str) -> FrameAxis:
     )
 
 
-def _frame_from_rows(rows: Iterable[FrameAxis]) -> dict:
+def _frame_from_rows(rows: Iterable[FrameAxis | Row[str, str, float, float, float | None]]) -> dict[str, Any]:
     by_axis = {row.axis: row for row in rows}
     frame = identity_frame()
     for axis in AXES:
@@ -331,7 +580,7 @@ def _frame_from_rows(rows: Iterable[FrameAxis]) -> dict:
     return frame
 
 
-def _parse_frame(frame: dict) -> dict[str, tuple[float, float, float | None]]:
+def _parse_frame(frame: dict[str, Any]) -> dict[str, tuple[float, float, float | None]]:
     """Frame dict -> {axis: (coarse, fine, rot)}; rot is None for rotary axes."""
     if not isinstance(frame, dict):
         raise ValueError("a frame must be an object with trans, fine, rot")
@@ -353,13 +602,56 @@ def _parse_frame(frame: dict) -> dict[str, tuple[float, float, float | None]]:
     return values
 
 
-def _tool_dict(row: Tool) -> dict:
-    return {"t": row.t, "name": row.name, "type": row.type, "length": row.length, "radius": row.radius,
-            "wear": {"length": row.wear_length, "radius": row.wear_radius}}
+def _tool_dict(row: Tool) -> dict[str, Any]:
+    out: dict[str, Any] = {"t": row.t, "name": row.name, "type": row.type, "length": row.length, "radius": row.radius,
+           "wear": {"length": row.wear_length, "radius": row.wear_radius}}
+    lathe = row.lathe
+    if lathe:                                    # a lathe tool: SL, L1, L2 and their wear (radius values)
+        out.update(sl=int(lathe["sl"]), l1=float(lathe["l1"]), l2=float(lathe["l2"]))
+        out["wear"].update(l1=float(lathe["wear_l1"]), l2=float(lathe["wear_l2"]))
+    return out
 
 
-def _log_dict(row: MeasurementLog) -> dict:
-    return {"id": row.id, "time": row.time, **{key: copy.deepcopy(getattr(row, key)) for key in LOG_FIELDS}}
+def _lathe_fields(data: dict[str, Any], wear: dict[str, Any], current: dict[str, Any] | None) -> dict[str, Any] | None:
+    """The lathe column after a write: given values (not None) replace the stored ones; a tool
+    that never had one stays a milling tool (NULL)."""
+    given = {k: data[k] for k in LATHE_TOOL_FIELDS if data.get(k) is not None}
+    given.update({f"wear_{k}": wear[k] for k in ("l1", "l2") if wear.get(k) is not None})
+    if not given and not current:
+        return None
+    out = {"sl": 0, "l1": 0.0, "l2": 0.0, "wear_l1": 0.0, "wear_l2": 0.0, **(current or {})}
+    for key, value in given.items():
+        out[key] = _int(value, key) if key == "sl" else _finite(value, key.replace("wear_", "wear."))
+    return out
+
+
+def _audit_dict(row: OffsetAudit) -> dict[str, Any]:
+    return {"id": row.id, "time": row.time, "kind": row.kind or "offset", "offset": row.offset,
+            "before": copy.deepcopy(row.before), "after": copy.deepcopy(row.after), "source": row.source,
+            "detail": copy.deepcopy(row.detail), "who": row.who, "level": row.who_level}
+
+
+def _user_dict(row: User) -> dict[str, Any]:
+    return {"name": row.name, "level": row.level, "created": row.created}
+
+
+def _token_dict(row: ApiToken) -> dict[str, Any]:
+    return {"name": row.name, "level": row.level, "created": row.created}
+
+
+def _log_dict(row: MeasurementLog) -> dict[str, Any]:
+    # the unit's session ends with the unit: nobody else holds these JSON values, no copy needed
+    return {"id": row.id, "time": row.time, **{key: getattr(row, key) for key in LOG_FIELDS}}
+
+
+def _program_dict(row: Program) -> dict[str, Any]:
+    return {"name": row.name, "text": row.text, "created_at": row.created_at, "updated_at": row.updated_at}
+
+
+def _memory_kind(kind: str) -> str:
+    if kind not in ("EV", "MV"):
+        raise ValueError(f"memory kind must be EV or MV, got {kind!r}")
+    return kind
 
 
 def _utc_now() -> str:
@@ -395,7 +687,7 @@ def _int(value: Any, what: str) -> int:
 
 
 def _positive_int(value: Any, what: str) -> int:
-    value = _int(value, what)
-    if value < 1:
-        raise ValueError(f"{what} must be >= 1, got {value}")
-    return value
+    number = _int(value, what)
+    if number < 1:
+        raise ValueError(f"{what} must be >= 1, got {number}")
+    return number

@@ -1,6 +1,6 @@
 """Workpiece probe calibration: length on a surface, radius in a ring of unknown centre.
 
-Spec: spec/jog-measuring.md §5.2/§5.3 [I], measuring-math §5.1, §7.2, §7.3, §7.5.
+Spec: spec/jog-measuring.md §5.2/jog-measuring §5.3 [I], measuring-math §5.1, measuring-math §7.2, measuring-math §7.3, measuring-math §7.5.
 
 Convention (measuring-math §5.1): the trigger value of travel direction ``dir`` along axis j is
 ``t_dir = c_switch,j − s_j`` with the ball-centre estimate ``c = rec + e`` (``rec`` = the NC's
@@ -21,7 +21,7 @@ Pass mid-points m_φ = (rec_φ(+j) + rec_φ(−j))/2 = M_j + k_j − e_φ,j with
     MP_j = (m0 + m180)/2 = M_j + k_j
     t(+j) = rec_0(+j) + e_j − (MP_j + R) = −(r − δ̄_j)      δ̄_j = (δ(+j) + δ(−j))/2
     t(−j) = rec_0(−j) + e_j − (MP_j − R) = +(r − δ̄_j)
-    effective diameter d_eff = 2·mean|t| = mean over axes of (t(−j) − t(+j))   (§7.2, §17 Q4)
+    effective diameter d_eff = 2·mean|t| = mean over axes of (t(−j) − t(+j))   (jog-measuring §7.2, measuring-math §17 Q4)
 
 Measuring later with c = rec + e and s = c − t: an edge at E probed +j gives
 s = (E − r + δ(+j)) + (r − δ̄_j) = E + k_j, probed −j gives E + k_j as well; a bore of any
@@ -29,31 +29,42 @@ diameter gives centre M' + k and the exact diameter. So everything is exact when
 pre-travel is symmetric per axis (δ(+j) = δ(−j), any value per axis, any latency, any
 eccentricity); an asymmetry only shifts all positions on axis j by the same k_j. That shift is
 not observable in a ring of unknown centre (rank argument: per axis the 4 latches determine
-e, M + δ(+), M − δ(−), never M and δ(±) apart) - only a known-centre reference (§7.2) could.
+e, M + δ(+), M − δ(−), never M and δ(±) apart) - only a known-centre reference (jog-measuring §7.2) could.
+That is the wave-1 model (pre-travel fixed to the machine axes). For the real probe, whose
+pre-travel turns with the spindle, and for every touch of every pass: the least-squares
+estimator ``estimate_ring`` / ``calibrate_ring`` below (its own derivation; docs/noise-bound.md).
 """
 
 from __future__ import annotations
 
-from dataclasses import replace
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
-from engine.frames import Frame
+from engine import alarms
+from engine.compensation import centre_trigger_value
+from engine.frames import Frame, rot_z
+from engine.lobing import LobingMap, fit_lobing_map
 from engine.plan_base import RingCalibrationPoint, RingPass
-from engine.planes import Plane, axis_index
-from engine.types import EdgePoint, MeasuringError, ProbeRecord
+from engine.planes import PLANES, Plane, axis_index
+from engine.types import EdgePoint, FloatArray, MeasuringError, ProbeRecord
 
-__all__ = ["calibrate_length", "calibrate_length_point", "calibrate_radius", "evaluate_probe_task",
-           "probe_values"]
+__all__ = ["PRETRAVEL_FRAMES", "RingEstimate", "RingTouch", "calibrate_length", "calibrate_length_point",
+           "calibrate_radius", "calibrate_ring", "calibration_jacobian", "calibration_variances", "estimate_ring",
+           "evaluate_probe_task",
+           "ideal_ring_touches", "probe_values", "ring_touches", "setup_noise_bound"]
 
 
 def calibrate_length(rec_infeed: float, setpoint: float, probe: ProbeRecord, length_old: float,
-                     plane: Plane) -> tuple[ProbeRecord, dict]:
+                     plane: Plane) -> tuple[ProbeRecord, dict[str, Any]]:
     """Probe length L1 on a surface at ``setpoint`` (infeed coordinate, WCS), travel −infeed.
 
     ``rec_infeed``: the NC's reference point on the infeed axis at the latch (nominal ball
     centre, or the ball tip with ``probe.length_to_tip`` = _CBIT[14]=1), computed with
-    ``length_old``. r = DP6 = ball_diameter/2 (spec §5.2 [I], measuring-math §7.5 [M]):
+    ``length_old``. r = DP6 = ball_diameter/2 (jog-measuring §5.2 [I], measuring-math §7.5 [M]):
 
         _CBIT[14]=0:  L1_new = L1_old + (rec_p − setpoint − r),   t(−p) = r
         _CBIT[14]=1:  L1_new = L1_old + (rec_p − setpoint),       t(−p) = 0
@@ -63,9 +74,9 @@ def calibrate_length(rec_infeed: float, setpoint: float, probe: ProbeRecord, len
     """
     r = probe.ball_diameter / 2.0
     tip = probe.length_to_tip
-    length_new = length_old + (rec_infeed - setpoint - (0.0 if tip else r))   # §7.5
+    length_new = length_old + (rec_infeed - setpoint - (0.0 if tip else r))   # measuring-math §7.5
     key = f"{plane.infeed}-"
-    trigger_new = 0.0 if tip else r                                           # §7.5 _WP[k,5]
+    trigger_new = 0.0 if tip else r                                           # measuring-math §7.5 _WP[k,5]
     triggers = dict(probe.trigger)
     old_trigger = triggers.get(key)
     triggers[key] = trigger_new
@@ -79,13 +90,13 @@ def calibrate_length(rec_infeed: float, setpoint: float, probe: ProbeRecord, len
 
 
 def calibrate_length_point(point: EdgePoint, setpoint: float, probe: ProbeRecord, length_old: float,
-                           plane: Plane) -> tuple[ProbeRecord, dict]:
+                           plane: Plane) -> tuple[ProbeRecord, dict[str, Any]]:
     """``calibrate_length`` from the stored point of ``probe.length`` (engine.plan raw edge
     program: ``touch.ball_centre`` = rec, + r·p̂ when L1 refers to the tip)."""
     p = plane.infeed_unit
     rec = np.asarray(point.touch.ball_centre, dtype=float)
     if probe.length_to_tip:
-        rec = rec - (probe.ball_diameter / 2.0) * p          # back to the tip (§0.1)
+        rec = rec - (probe.ball_diameter / 2.0) * p          # back to the tip (jog-measuring §0.1)
     return calibrate_length(float(rec @ p), setpoint, probe, length_old, plane)
 
 
@@ -95,14 +106,14 @@ def _pass_mid(ring_pass: RingPass, axis: str) -> tuple[float, float, float]:
         plus = float(np.asarray(ring_pass.rec[f"{axis}+"], dtype=float)[j])
         minus = float(np.asarray(ring_pass.rec[f"{axis}-"], dtype=float)[j])
     except KeyError as missing:
-        raise MeasuringError(61301, f"ring pass at {ring_pass.spindle_angle:g}° lacks {missing}") from None
+        raise MeasuringError(alarms.PROBE_NOT_SWITCHED, f"ring pass at {ring_pass.spindle_angle:g}° lacks {missing}") from None
     return 0.5 * (plus + minus), plus, minus
 
 
 def calibrate_radius(point: RingCalibrationPoint, probe: ProbeRecord, plane: Plane,
-                     wcs2bcs: Frame | None = None) -> tuple[ProbeRecord, dict]:
+                     wcs2bcs: Frame | None = None) -> tuple[ProbeRecord, dict[str, Any]]:
     """Trigger values ±a, ±o, skew and effective diameter from a ring of known diameter and
-    unknown centre (spec §5.3 [I], measuring-math §7.3; derivation in the module docstring).
+    unknown centre (jog-measuring §5.3 [I], measuring-math §7.3; derivation in the module docstring).
 
     ``point.passes`` holds the pass at SPOS 180° and the pass at SPOS 0° (raw ``rec`` in the
     measuring WCS, keyed "X+", "X-", ...). ``wcs2bcs``: the measuring WCS -> BCS frame; the skew
@@ -124,19 +135,19 @@ def calibrate_radius(point: RingCalibrationPoint, probe: ProbeRecord, plane: Pla
     for axis in (plane.first, plane.second):
         m180, _, _ = _pass_mid(pass180, axis)
         m0, plus0, minus0 = _pass_mid(pass0, axis)
-        e_j = 0.5 * (m180 - m0)                                  # §7.3 e = (m180 − m0)/2
-        mp_j = 0.5 * (m0 + m180)                                 # §7.3 MP = (m0 + m180)/2
+        e_j = 0.5 * (m180 - m0)                                  # jog-measuring §7.3 e = (m180 − m0)/2
+        mp_j = 0.5 * (m0 + m180)                                 # jog-measuring §7.3 MP = (m0 + m180)/2
         centre[axis] = mp_j
         skew_wcs[axis_index(axis)] = e_j
-        # §7.2 t = rec + e − S, from the 0° pass only: its chords run through the centre (the
+        # jog-measuring §7.2 t = rec + e − S, from the 0° pass only: its chords run through the centre (the
         # search ran at 0°); the 180° pass's chords are 2e off-centre, which biases their ends
         triggers[f"{axis}+"] = plus0 + e_j - (mp_j + half)
         triggers[f"{axis}-"] = minus0 + e_j - (mp_j - half)
     for key, value in triggers.items():
         if (value < 0.0) != key.endswith("+") or value == 0.0:
-            raise MeasuringError(61303, f"trigger value {key} = {value:.4f} has the wrong sign: "
+            raise MeasuringError(alarms.SAFE_AREA, f"trigger value {key} = {value:.4f} has the wrong sign: "
                                         "check the ring diameter")
-    d_eff = 2.0 * float(np.mean([abs(v) for v in triggers.values()]))   # §7.2, spec §5.3 [I]
+    d_eff = 2.0 * float(np.mean([abs(v) for v in triggers.values()]))   # jog-measuring §7.2, jog-measuring §5.3 [I]
     skew_mcs = skew_wcs if wcs2bcs is None else wcs2bcs.dir_child2parent(skew_wcs)
     new_triggers = dict(probe.trigger)
     new_triggers.update(triggers)
@@ -155,7 +166,7 @@ def calibrate_radius(point: RingCalibrationPoint, probe: ProbeRecord, plane: Pla
     return record, values
 
 
-def probe_values(probe: ProbeRecord) -> dict:
+def probe_values(probe: ProbeRecord) -> dict[str, Any]:
     """JSON view of a probe record (the ``probe`` result key of design.md §4)."""
     return {"number": probe.number, "ball_diameter": probe.ball_diameter,
             "effective_diameter": probe.effective_diameter,
@@ -165,11 +176,14 @@ def probe_values(probe: ProbeRecord) -> dict:
             "calibrated_length": probe.calibrated_length}
 
 
-def evaluate_probe_task(task: str, params: dict, point, probe: ProbeRecord, plane: Plane, *,
-                        length_old: float | None = None, wcs2bcs: Frame | None = None
-                        ) -> tuple[ProbeRecord, dict]:
+def evaluate_probe_task(task: str, params: dict[str, Any], point: object, probe: ProbeRecord, plane: Plane, *,
+                        length_old: float | None = None, wcs2bcs: Frame | None = None,
+                        pretravel_frame: str | None = None, first_harmonic: str = "convention"
+                        ) -> tuple[ProbeRecord, dict[str, Any]]:
     """``probe.length`` / ``probe.radius`` (design.md §4): (new record, result values with the
-    ``probe`` key plus the calibration numbers). ``length_old``: the probe's L1 (tool data)."""
+    ``probe`` key plus the calibration numbers). ``length_old``: the probe's L1 (tool data).
+    ``pretravel_frame``: None = calibrate_radius (as before); "probe" / "machine" = the
+    least-squares calibrate_ring with that pre-travel model."""
     if task == "probe.length":
         if not isinstance(point, EdgePoint):
             raise ValueError(f"probe.length needs an EdgePoint, got {type(point).__name__}")
@@ -182,7 +196,598 @@ def evaluate_probe_task(task: str, params: dict, point, probe: ProbeRecord, plan
     elif task == "probe.radius":
         if not isinstance(point, RingCalibrationPoint):
             raise ValueError(f"probe.radius needs a RingCalibrationPoint, got {type(point).__name__}")
-        record, numbers = calibrate_radius(point, probe, plane, wcs2bcs)
+        if pretravel_frame is None:
+            record, numbers = calibrate_radius(point, probe, plane, wcs2bcs)
+        else:
+            record, numbers = calibrate_ring(point, probe, plane, wcs2bcs, frame=pretravel_frame,
+                                             first_harmonic=first_harmonic)
     else:
         raise ValueError(f"not a probe calibration task: {task!r}")
     return record, {"probe": probe_values(record), **numbers}
+
+
+# =====================================================================================
+# Least-squares ring calibration from every touch (design.md §9.8, issue [probe-physics])
+# =====================================================================================
+#
+# Model (one touch i: NC reference rec_i at the latch, unit travel d_i in the plane, SPOS φ_i).
+# The true ball centre is b = rec + E(φ), E(φ) = Rz(φ)·e (eccentricity e at 0°, machine X/Y).
+# It first touched the ring (centre M, radius R) with the ball (radius r) at b − δ_i·d_i, δ_i =
+# pre-travel + v·τ (+ noise), so |b − δ_i·d_i − M| = R − r. Split b − M into the part along d_i
+# and the chord offset h_i across it:
+#
+#     (rec_i + E_i − M)·d_i = R − ρ_i + s(h_i),   ρ_i = r − δ_i,   s(h) = √((R−r)² − h²) − (R−r)
+#     h_i = (rec_i + E_i − M)·d_i⊥                                       (s ≈ −h²/2(R−r) ≤ 0)
+#
+# ρ_i is the effective radius of the travel direction (the trigger value's magnitude, jog-measuring §5.1);
+# it depends on the direction class j(i): the travel angle in the probe's frame θ − φ
+# (pretravel_frame "probe": the lobing turns with the spindle) or in the machine frame θ
+# ("machine", the wave-1 simulator). E_i·d_i = e·q_i with q_i = Rz(−φ_i)·d_i,mcs (the direction
+# seen by the probe). Unknowns: M (2), e (2), ρ_j (one per class); r enters only s(h) and is
+# taken as the nominal radius there (error h²Δr/2(R−r)², sub-nm for h < 0.5 mm).
+#
+# What is observable (rank of the along-d part; s(h) adds only 2nd-order information):
+#  - probe frame: e and a first harmonic of ρ (ρ_j ← ρ_j − v·(cos θ_j, sin θ_j), e ← e + v)
+#    leave every e·q_i + ρ_j unchanged — an asymmetric pre-travel k = (δ+ − δ−)/2 turns with the
+#    spindle and pushes the ball along d exactly like an eccentricity does, in every direction.
+#    They cannot be separated by any set of directions or spindle angles, so the convention
+#    Σ_j ρ_j·(cos θ_j, sin θ_j) = 0 puts the first harmonic into the skew: stored skew = e − k
+#    (the manual's (m180 − m0)/2 for the 4-direction case), trigger magnitudes per axis equal.
+#    The ring centre M *is* observable once two spindle angles differ (it does not turn) — this
+#    is how the 180° pass observes k: every later touch is then exact, in every direction.
+#  - machine frame: e turns with the spindle, ρ does not, so e is observable (two spindle
+#    angles), but M·d_i and a first harmonic of the machine-fixed ρ are the same function of the
+#    direction: with an unknown centre the convention puts k into the centre (reported centre =
+#    M + k, trigger magnitudes per axis equal; a later touch along ±j is off by k_j) and the
+#    result says so (center_observable False). With a known centre all ρ_j are free: X+ ≠ X−.
+#  - one spindle angle only: M and e (probe frame) resp. M, e and k (machine frame) are one
+#    first harmonic -> NEEDS_SPOS, unless the centre or the skew is given.
+#  - the inseparability is exact only along the travel. Across it the two differ: the
+#    eccentricity moves the ball sideways, the pre-travel does not. So (a) a later touch at
+#    oblique incidence α on a flat face (a part turned by α against the probing axes) keeps a
+#    systematic error up to |k|·sin α along the face normal under the convention (0.33 µm for
+#    k = 1.5 µm at 12.5°), and (b) chords off the ring centre (oblique incidence on the ring
+#    wall, ring_program chord_offset) observe k: ``first_harmonic="estimate"`` then drops the
+#    convention, skew = e, centre = M in both frames, X+ ≠ X− (needs chords with |h| of the order
+#    of (R − r)/2, else CIRCLE_UNDETERMINED). It relies on the pre-travel acting along the
+#    travel at oblique incidence (the simulator's model); a real probe whose trigger follows
+#    the contact-force direction must be checked against it first — hence not the default.
+# The chord offsets h (start off-centre, the 180° pass 2e off-centre) use the estimated skew and
+# centre; under the convention an unobservable k therefore leaks in by at most
+# |k|·max|h|/(R − r) (0.03 µm for k = 1.5 µm, h = 0.2 mm, R − r = 10.5 mm). Exact (to rounding)
+# when k = 0, or the centre is known (machine frame), or first_harmonic="estimate".
+#
+# Estimator: Gauss-Newton on Σ_i f_i², f_i = (rec_i − M)·d_i + e·q_i − (R − ρ_j) − s(h_i)
+# (residual along d_i), the convention by a null-space parametrisation of the ρ block; starting
+# from the linear solution (s = 0). Covariance σ²·T(J_zᵀJ_z)⁻¹Tᵀ, σ a priori (``sigma``) or
+# σ̂ = sqrt(Σf²/dof). For the standard JOG program (search, 180°, 0°: 12 touches, probe frame)
+# the variance of the correction a later axis-parallel touch inherits, e·q + ρ, is 17/48·σ² =
+# 0.354σ² (calibrate_radius: 3/4·σ², it uses the 0° pass only); see docs/noise-bound.md.
+
+PRETRAVEL_FRAMES = ("probe", "machine")
+_ANGLE_TOL = 1e-6          # deg: touches whose direction classes differ by less are one class
+
+
+@dataclass(frozen=True)
+class RingTouch:
+    """One raw ring touch: NC reference ``rec`` at the latch (WCS, no skew, no trigger values),
+    unit travel ``direction`` (WCS, in the working plane) and the SPOS angle it was made at."""
+
+    rec: FloatArray
+    direction: FloatArray
+    spindle_angle: float = 0.0
+    label: str = ""
+
+
+def _key_direction(key: str, plane: Plane) -> FloatArray:
+    axis, sign = key[:-1], key[-1]
+    if sign not in "+-" or axis not in (plane.first, plane.second):
+        raise ValueError(f"ring pass key {key!r} is no plane-axis direction; give RingPass.directions")
+    return (1.0 if sign == "+" else -1.0) * plane.unit(axis)
+
+
+def ring_touches(point: RingCalibrationPoint, plane: Plane) -> tuple[RingTouch, ...]:
+    """Every touch of a ring calibration: the centre search (SPOS 0°) and all passes."""
+    passes = [p for p in (point.search, *point.passes) if p is not None]
+    out = []
+    for ring_pass in passes:
+        for key, rec in ring_pass.rec.items():
+            d = ring_pass.directions.get(key)
+            d = _key_direction(key, plane) if d is None else np.asarray(d, dtype=float)
+            out.append(RingTouch(np.asarray(rec, dtype=float), d / np.linalg.norm(d),
+                                 float(ring_pass.spindle_angle), f"SPOS {ring_pass.spindle_angle:g} {key}"))
+    return tuple(out)
+
+
+@dataclass(frozen=True)
+class RingEstimate:
+    """Result of ``estimate_ring`` (the model and its observability: comment block above).
+
+    ``center`` (a, o) in the measuring WCS; ``skew`` machine X/Y at SPOS 0°, the eccentricity
+    (``skew_effective`` False) or eccentricity − k (True, probe frame); ``angles``/``radii``:
+    the direction classes (deg, in ``frame``; probe frame = machine frame at SPOS 0°) and their
+    effective radii ρ_j; ``lobing``: the map through them. ``trigger``/``trigger_std``: the
+    record's values for ±1st/±2nd plane axis at SPOS 0° (t(+) = −ρ, t(−) = +ρ, jog-measuring §5.1) and their
+    std; ``surface_std``: std of the correction e·q + ρ a later touch in that direction inherits
+    (what the set-up error sees). ``residuals``: per touch, along its direction, input order.
+    ``covariance`` of ``param_names`` (fixed parameters have zero rows).
+    """
+
+    frame: str
+    diameter: float
+    plane_axes: tuple[str, str]
+    center: FloatArray
+    center_observable: bool
+    skew: FloatArray
+    skew_effective: bool
+    angles: FloatArray
+    radii: FloatArray
+    lobing: LobingMap
+    trigger: dict[str, float]
+    trigger_std: dict[str, float]
+    surface_std: dict[str, float]
+    effective_diameter: float
+    effective_diameter_std: float
+    residuals: FloatArray
+    form_error: float
+    n: int
+    dof: int
+    sigma: float
+    covariance: FloatArray | None
+    param_names: tuple[str, ...]
+    max_chord_offset: float
+    notes: tuple[str, ...]
+
+    @property
+    def rms(self) -> float:
+        return float(np.sqrt(np.mean(self.residuals ** 2))) if len(self.residuals) else 0.0
+
+    @property
+    def sigma_hat(self) -> float:
+        return float(np.sqrt(np.sum(self.residuals ** 2) / self.dof)) if self.dof > 0 else float("nan")
+
+    @property
+    def std(self) -> dict[str, float]:
+        if self.covariance is None:
+            return {name: float("nan") for name in self.param_names}
+        d = np.sqrt(np.clip(np.diag(self.covariance), 0.0, None))
+        return {name: float(v) for name, v in zip(self.param_names, d, strict=True)}
+
+    def values_json(self) -> dict[str, Any]:
+        """JSON-ready numbers: the calibrate_radius keys plus quality and observability."""
+        std = self.std
+        first, second = self.plane_axes
+        return {
+            "center": {first: float(self.center[0]), second: float(self.center[1])},
+            "skew": {"X": float(self.skew[0]), "Y": float(self.skew[1])},
+            "trigger": {k: float(v) for k, v in self.trigger.items()},
+            "effective_diameter": float(self.effective_diameter),
+            "std": {"center": {first: std["center_a"], second: std["center_o"]},
+                    "skew": {"X": std["skew_X"], "Y": std["skew_Y"]},
+                    "trigger": dict(self.trigger_std), "surface": dict(self.surface_std),
+                    "effective_diameter": float(self.effective_diameter_std)},
+            "residuals": [float(r) for r in self.residuals],
+            "rms": self.rms, "form_error": float(self.form_error), "n": int(self.n),
+            "sigma_hat": self.sigma_hat,
+            "pretravel_frame": self.frame,
+            "observable": {"center": bool(self.center_observable),
+                           "skew": "eccentricity - k" if self.skew_effective else "eccentricity"},
+            "notes": list(self.notes),
+            "lobing": self.lobing.values_json(),
+        }
+
+
+def _unit2(v: npt.ArrayLike) -> FloatArray:
+    u = np.asarray(v, dtype=float)
+    n = float(np.linalg.norm(u))
+    if not np.isfinite(n) or n == 0.0:
+        raise ValueError(f"direction must be a finite non-zero vector, got {u}")
+    return u / n
+
+
+def _classes(angles: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """(class angle per class, class index per touch), circular clustering within _ANGLE_TOL."""
+    centres: list[float] = []
+    index = np.empty(len(angles), dtype=int)
+    for i, a in enumerate(np.mod(angles, 360.0)):
+        for j, c in enumerate(centres):
+            if abs((a - c + 180.0) % 360.0 - 180.0) < _ANGLE_TOL:
+                index[i] = j
+                break
+        else:
+            centres.append(0.0 if a > 360.0 - _ANGLE_TOL else float(a))
+            index[i] = len(centres) - 1
+    return np.array(centres), index
+
+
+def _null_space(c: FloatArray, m: int) -> FloatArray:
+    if c.size == 0:
+        return np.eye(m)
+    _, sv, vt = np.linalg.svd(c)
+    rank = int(np.sum(sv > 1e-9 * max(1.0, sv[0])))
+    return vt[rank:].T
+
+
+def estimate_ring(touches: Sequence[RingTouch], diameter: float, probe: ProbeRecord, plane: Plane, *,
+                  frame: str = "probe", center: npt.ArrayLike | None = None, skew: npt.ArrayLike | None = None,
+                  wcs2bcs: Frame | None = None,
+                  sigma: float | None = None, first_harmonic: str = "convention") -> RingEstimate:
+    """Ring centre, skew and every direction's effective radius from all touches, least squares.
+
+    ``touches``: RingTouch (``ring_touches`` of a RingCalibrationPoint, or any set: n directions
+    at any spindle angles). ``diameter``: the ring's known diameter. ``frame``: where the pre-
+    travel lives, "probe" (turns with SPOS) or "machine" (wave-1 simulator). ``center``: a known
+    ring centre (WCS point or (a, o)), ``skew``: a known skew (machine X/Y at 0°) — both optional,
+    they remove the corresponding unknowns. ``wcs2bcs``: measuring WCS -> BCS (= MCS). ``sigma``:
+    a-priori σ per touch for the covariance (else σ̂ from the residuals). ``first_harmonic``:
+    "convention" (default: the first harmonic of the pre-travel goes into skew resp. centre) or
+    "estimate" (separate it through the chord offsets: needs oblique chords).
+
+    Model, observability, convention and accuracy: the comment block above this class. Failures:
+    ValueError for bad input; MeasuringError NEEDS_SPOS when one spindle angle leaves centre and
+    skew inseparable, CIRCLE_UNDETERMINED for any other rank defect (e.g. directions on one axis).
+    """
+    if frame not in PRETRAVEL_FRAMES:
+        raise ValueError(f"frame must be one of {PRETRAVEL_FRAMES}, got {frame!r}")
+    big_r = float(diameter) / 2.0
+    if not big_r > 0.0:
+        raise ValueError(f"ring diameter must be > 0, got {diameter}")
+    r_nom = probe.ball_diameter / 2.0
+    a_s = big_r - r_nom
+    if not a_s > 0.0:
+        raise ValueError(f"ring diameter {diameter} must exceed the ball diameter {probe.ball_diameter}")
+    touches = tuple(touches)
+    n = len(touches)
+    if n < 4:
+        raise MeasuringError(alarms.CIRCLE_PARAMETERS, f"a ring calibration needs 4 or more touches, got {n}")
+    to_mcs = (lambda v: v) if wcs2bcs is None else wcs2bcs.dir_child2parent
+    rec = np.empty((n, 2))
+    d = np.empty((n, 2))
+    q = np.empty((n, 2))
+    q_perp = np.empty((n, 2))
+    theta = np.empty(n)
+    phis = np.empty(n)
+    for i, t in enumerate(touches):
+        rec[i] = plane.to_aop(np.asarray(t.rec, dtype=float))[:2]
+        d_aop = plane.to_aop(_unit2(t.direction))
+        if abs(d_aop[2]) > 1e-9:
+            raise ValueError(f"ring touch {t.label or i} does not travel in the working plane")
+        d[i] = _unit2(d_aop[:2])
+        d_mcs = to_mcs(plane.to_xyz([d[i, 0], d[i, 1], 0.0]))
+        dp_mcs = to_mcs(plane.to_xyz([-d[i, 1], d[i, 0], 0.0]))
+        if abs(d_mcs[2]) > 1e-9:
+            raise ValueError("ring touches must be perpendicular to the spindle axis (machine Z)")
+        phi = float(t.spindle_angle)
+        turn = rot_z(-phi)
+        q[i], q_perp[i] = (turn @ d_mcs)[:2], (turn @ dp_mcs)[:2]
+        theta_m = float(np.degrees(np.arctan2(d_mcs[1], d_mcs[0])))
+        theta[i] = theta_m - phi if frame == "probe" else theta_m
+        phis[i] = phi % 360.0
+    d_perp = np.column_stack([-d[:, 1], d[:, 0]])
+    class_angles, cls = _classes(theta)
+    m = len(class_angles)
+    n_par = 4 + m
+    names = ("center_a", "center_o", "skew_X", "skew_Y", *[f"rho_{a:g}" for a in class_angles])
+
+    # fixed parameters, free ones, convention on the ρ block
+    x_fixed = np.zeros(n_par)
+    free_cols: list[FloatArray] = []
+    if center is None:
+        free_cols += [np.eye(n_par)[:, 0], np.eye(n_par)[:, 1]]
+    else:
+        c_arr = np.asarray(center, dtype=float)
+        x_fixed[:2] = plane.to_aop(c_arr)[:2] if c_arr.shape == (3,) else c_arr[:2]
+    if skew is None:
+        free_cols += [np.eye(n_par)[:, 2], np.eye(n_par)[:, 3]]
+    else:
+        x_fixed[2:4] = np.asarray(skew, dtype=float)[:2]
+    if first_harmonic not in ("convention", "estimate"):
+        raise ValueError(f"first_harmonic must be 'convention' or 'estimate', got {first_harmonic!r}")
+    constrained = (frame == "probe" and skew is None) or (frame == "machine" and center is None)
+    th_rad = np.radians(class_angles)
+    harmonic = np.vstack([np.cos(th_rad), np.sin(th_rad)])
+    null = _null_space(harmonic, m) if constrained else np.eye(m)
+    t_mat = np.column_stack(free_cols + [np.concatenate([np.zeros(4), col]) for col in null.T])
+    t_full = np.column_stack(free_cols + [np.concatenate([np.zeros(4), col]) for col in np.eye(m)])
+
+    onehot = np.zeros((n, m))
+    onehot[np.arange(n), cls] = 1.0
+
+    def residual_jac(x: FloatArray, sagitta: bool = True) -> tuple[FloatArray, FloatArray]:
+        mc, e, rho = x[:2], x[2:4], x[4:]
+        w = rec - mc
+        h = np.sum(w * d_perp, axis=1) + q_perp @ e
+        if sagitta:
+            if np.any(np.abs(h) >= a_s):
+                raise MeasuringError(alarms.CIRCLE_UNDETERMINED, "ring touches miss the ring (chord offset)")
+            root = np.sqrt(a_s * a_s - h * h)
+            s, ds = root - a_s, -h / root
+        else:
+            s, ds = np.zeros(n), np.zeros(n)
+        f = np.sum(w * d, axis=1) + q @ e - (big_r - rho[cls]) - s
+        jac = np.column_stack([-d + ds[:, None] * d_perp, q - ds[:, None] * q_perp, onehot])
+        return f, jac
+
+    # linear start (s = 0), then Gauss-Newton with the chord offsets
+    f0, j0 = residual_jac(x_fixed, sagitta=False)
+    jz = j0 @ t_mat
+    sv = np.linalg.svd(jz, compute_uv=False)
+    if len(sv) < t_mat.shape[1] or sv[-1] <= 1e-9 * max(1.0, sv[0]):
+        if len(set(np.round(phis, 6))) < 2 and center is None and skew is None:
+            raise MeasuringError(alarms.NEEDS_SPOS, "ring centre and skew cannot be told apart at one spindle "
+                                 "orientation: calibrate at 0° and 180° (SPOS), or give the centre")
+        raise MeasuringError(alarms.CIRCLE_UNDETERMINED, "the ring touches do not determine centre, skew "
+                             "and trigger values (directions must span the plane)")
+    z, *_ = np.linalg.lstsq(jz, -f0, rcond=None)
+    x = x_fixed + t_mat @ z
+    for _ in range(30):      # the chord term is a small correction: 2–4 steps to rounding
+        f, jac = residual_jac(x)
+        step, *_ = np.linalg.lstsq(jac @ t_mat, -f, rcond=None)
+        x = x + t_mat @ step
+        if np.linalg.norm(step) <= 1e-13 * max(big_r, 1.0):
+            break
+    if constrained and first_harmonic == "estimate":
+        # the chord offsets carry the first harmonic apart from skew (probe frame) or centre
+        # (machine frame): Gauss-Newton on the full model from the convention's solution
+        f, jac = residual_jac(x)
+        sv = np.linalg.svd(jac @ t_full, compute_uv=False)
+        if len(sv) < t_full.shape[1] or sv[-1] <= 1e-9 * max(1.0, sv[0]):
+            raise MeasuringError(alarms.CIRCLE_UNDETERMINED, "skew and the first harmonic of the pre-travel "
+                                 "cannot be told apart: probe chords off the ring centre (oblique incidence)")
+        t_mat, constrained = t_full, False
+        for _ in range(30):
+            f, jac = residual_jac(x)
+            step, *_ = np.linalg.lstsq(jac @ t_mat, -f, rcond=None)
+            x = x + t_mat @ step
+            if np.linalg.norm(step) <= 1e-13 * max(big_r, 1.0):
+                break
+    f, jac = residual_jac(x)
+    jz = jac @ t_mat
+    dof = n - t_mat.shape[1]
+    if sigma is not None:
+        s_used = float(sigma)
+    elif dof > 0:
+        s_used = float(np.sqrt(np.sum(f * f) / dof))
+    else:
+        s_used = float("nan")
+    cov = None
+    if np.isfinite(s_used):
+        cov_z = s_used * s_used * np.linalg.inv(jz.T @ jz)
+        cov = t_mat @ cov_z @ t_mat.T
+        cov = 0.5 * (cov + cov.T)
+
+    mc, e, rho = x[:2], x[2:4], x[4:]
+    axial = abs(centre_trigger_value(probe, -plane.infeed_unit, plane))
+    lobing = fit_lobing_map(class_angles, rho, frame=frame, skew=e,
+                            covariance=None if cov is None else cov[4:, 4:],
+                            include_first=not constrained, axial_radius=axial)
+
+    def spread(c: FloatArray) -> float:
+        return float("nan") if cov is None else float(np.sqrt(max(c @ cov @ c, 0.0)))
+
+    trigger: dict[str, float] = {}
+    trigger_std: dict[str, float] = {}
+    surface_std: dict[str, float] = {}
+    for axis in (plane.first, plane.second):
+        for sign in (1.0, -1.0):
+            key = f"{axis}{'+' if sign > 0 else '-'}"
+            d_mcs = to_mcs(sign * plane.unit(axis))
+            theta_key = lobing.frame_angle(d_mcs, 0.0)
+            w = lobing.weights(theta_key)
+            rho_key = float(w @ rho)
+            trigger[key] = -rho_key if sign > 0 else rho_key
+            c_rho = np.concatenate([np.zeros(4), w])
+            trigger_std[key] = spread(c_rho)
+            surface_std[key] = spread(c_rho + np.concatenate([[0.0, 0.0], d_mcs[:2], np.zeros(m)]))
+    w0 = np.concatenate([np.zeros(4), lobing.weights_mean()])
+    d_eff = 2.0 * lobing.mean_radius
+    h_all = np.sum((rec - mc) * d_perp, axis=1) + q_perp @ e
+
+    notes = []
+    center_observable = not (frame == "machine" and center is None) or not constrained
+    skew_effective = frame == "probe" and skew is None and constrained
+    if first_harmonic == "estimate":
+        notes.append("first harmonic of the pre-travel estimated from the chord offsets (oblique "
+                     "incidence): skew is the eccentricity, X+ and X− are stored apart")
+    if skew_effective:
+        notes.append("skew = eccentricity - k: the first harmonic k of the pre-travel (k = (δ+ − δ−)/2 "
+                     "per axis) turns with the spindle and moves the ball along every probing direction "
+                     "exactly like an eccentricity; the two cannot be separated, and the stored pair "
+                     "(skew, trigger values) is exact for every direction at any spindle angle")
+    if not center_observable:
+        notes.append("ring centre = M + k (k = (δ+ − δ−)/2 per axis, pre-travel fixed to the machine "
+                     "axes): not separable from the centre in a ring of unknown centre; the trigger "
+                     "values are the symmetric parts and later positions probed along ±j are off by "
+                     "k_j. Calibrate with a known centre (centre=...) to store X+ and X− apart")
+    if constrained and float(np.max(np.abs(h_all))) > 0.0:
+        notes.append(f"chord offsets up to {float(np.max(np.abs(h_all))):.4f} mm: an unobservable k "
+                     f"leaks into the sagitta term by at most |k|·{float(np.max(np.abs(h_all))) / a_s:.2e}")
+    return RingEstimate(
+        frame=frame, diameter=float(diameter), plane_axes=(plane.first, plane.second), center=mc.copy(),
+        center_observable=center_observable, skew=e.copy(), skew_effective=skew_effective,
+        angles=class_angles, radii=rho.copy(), lobing=lobing, trigger=trigger, trigger_std=trigger_std,
+        surface_std=surface_std, effective_diameter=d_eff, effective_diameter_std=2.0 * spread(w0),
+        residuals=f, form_error=float(f.max() - f.min()), n=n, dof=dof, sigma=s_used, covariance=cov,
+        param_names=names, max_chord_offset=float(np.max(np.abs(h_all))), notes=tuple(notes))
+
+
+def calibrate_ring(point: RingCalibrationPoint, probe: ProbeRecord, plane: Plane,
+                   wcs2bcs: Frame | None = None, *, frame: str = "probe", center: npt.ArrayLike | None = None,
+                   sigma: float | None = None, first_harmonic: str = "convention") -> tuple[ProbeRecord, dict[str, Any]]:
+    """``calibrate_radius`` by least squares from every touch (search + all passes).
+
+    Same inputs and the same result keys (``center``, ``skew``, ``trigger``,
+    ``trigger_difference``, ``effective_diameter``, ``effective_diameter_difference``) plus
+    ``std``, ``residuals``, ``rms``, ``form_error``, ``n``, ``sigma_hat``, ``pretravel_frame``,
+    ``observable``, ``notes`` and ``lobing`` (RingEstimate.values_json). ``frame``: "probe"
+    (default: the real probe and the wave-2 simulator) or "machine" (wave-1). ``center``: a
+    known ring centre (WCS), optional. ``first_harmonic``: as estimate_ring ("estimate" with a
+    ring_program chord_offset). The record gets the trigger values of ±1st/±2nd axis,
+    the skew (machine X/Y at 0°) and the effective diameter 2·c0 (mean over all directions;
+    the 4-direction value equals calibrate_radius's 2·mean|t|).
+    """
+    est = estimate_ring(ring_touches(point, plane), point.diameter, probe, plane, frame=frame,
+                        center=center, wcs2bcs=wcs2bcs, sigma=sigma, first_harmonic=first_harmonic)
+    for key, value in est.trigger.items():
+        if (value < 0.0) != key.endswith("+") or value == 0.0:
+            raise MeasuringError(alarms.SAFE_AREA, f"trigger value {key} = {value:.4f} has the wrong sign: "
+                                 "check the ring diameter")
+    new_triggers = dict(probe.trigger)
+    new_triggers.update(est.trigger)
+    record = replace(probe, trigger=new_triggers, skew=(float(est.skew[0]), float(est.skew[1])),
+                     effective_diameter=float(est.effective_diameter), calibrated_radius=True)
+    values = est.values_json()
+    values["trigger_difference"] = {k: (None if k not in probe.trigger else float(v - probe.trigger[k]))
+                                    for k, v in est.trigger.items()}
+    values["effective_diameter_difference"] = (None if probe.effective_diameter <= 0.0
+                                               else float(est.effective_diameter - probe.effective_diameter))
+    return record, values
+
+
+# --- the noise bound of a calibrated set-up (docs/noise-bound.md) ----------------------------
+
+def ideal_ring_touches(n_directions: int = 4, spindle_angles: Sequence[float] = (0.0, 180.0, 0.0), *, diameter: float = 25.0,
+                       ball_diameter: float = 4.0, start_deg: float = 0.0) -> tuple[RingTouch, ...]:
+    """The linear design of a ring calibration: chords through the centre (0, 0) of an ideal
+    ring (G17, no pre-travel, no skew), ``n_directions`` 360°/n apart from ``start_deg`` at
+    each of ``spindle_angles``. Default: the JOG program (search at 0°, passes at 180° and 0°)."""
+    reach = diameter / 2.0 - ball_diameter / 2.0
+    out = []
+    for phi in spindle_angles:
+        for k in range(int(n_directions)):
+            a = np.radians(start_deg + 360.0 * k / n_directions)
+            d = np.array([np.cos(a), np.sin(a), 0.0])
+            out.append(RingTouch(reach * d, d, float(phi), f"SPOS {phi:g} {np.degrees(a):g}"))
+    return tuple(out)
+
+
+def calibration_variances(touches: Sequence[RingTouch] | None = None, *, frame: str = "probe",
+                          diameter: float = 25.0, ball_diameter: float = 4.0,
+                          center: npt.ArrayLike | None = None) -> dict[str, dict[str, float] | float]:
+    """Variances in units of σ² (σ = the noise of one touch) of what a ring calibration stores:
+    ``surface`` (the correction skew·d̂ + ρ a later touch along ±1st/±2nd inherits — what the
+    set-up sees), ``trigger``, ``center``, ``skew``, ``effective_diameter``. ``touches``: the
+    design (default ``ideal_ring_touches()``: the JOG program, 12 touches); estimator
+    ``estimate_ring`` with σ = 1. The JOG program, probe frame: surface 17/48, trigger 1/6,
+    centre and skew 3/16 (docs/noise-bound.md jog-measuring §2)."""
+    touches = ideal_ring_touches(diameter=diameter, ball_diameter=ball_diameter) if touches is None else touches
+    est = estimate_ring(touches, diameter, ProbeRecord(ball_diameter=ball_diameter), PLANES["G17"],
+                        frame=frame, center=center, sigma=1.0)
+    std = est.std
+    return {"surface": {k: v * v for k, v in est.surface_std.items()},
+            "trigger": {k: v * v for k, v in est.trigger_std.items()},
+            "center": {"X": std["center_a"] ** 2, "Y": std["center_o"] ** 2},
+            "skew": {"X": std["skew_X"] ** 2, "Y": std["skew_Y"] ** 2},
+            "effective_diameter": est.effective_diameter_std ** 2}
+
+
+def _ideal_jog_point(diameter: float, ball_diameter: float) -> RingCalibrationPoint:
+    """The JOG ring program on an ideal ring: chords through the centre (0, 0), G17."""
+    reach = diameter / 2.0 - ball_diameter / 2.0
+    recs = {"X+": np.array([reach, 0.0, 0.0]), "X-": np.array([-reach, 0.0, 0.0]),
+            "Y+": np.array([0.0, reach, 0.0]), "Y-": np.array([0.0, -reach, 0.0])}
+    passes = [RingPass(angle, {k: v.copy() for k, v in recs.items()}) for angle in (0.0, 180.0, 0.0)]
+    return RingCalibrationPoint(diameter, passes[0], (passes[1], passes[2]))
+
+
+def calibration_jacobian(estimator: str = "ls", *, diameter: float = 25.0, ball_diameter: float = 4.0,
+                         frame: str = "probe") -> dict[str, Any]:
+    """How the stored values respond to the noise of each of the 12 touches of the JOG ring
+    program (search, 180°, 0°; rows: skew X, skew Y, then ρ(X+), ρ(X−), ρ(Y+), ρ(Y−) with
+    ρ = ∓t; columns: the touches in ring_touches order, a latch 1 mm further along its
+    direction). ``estimator``: "ls" (calibrate_ring) or "calibrate_radius". Both are linear
+    in the latches here, so this is exact (finite difference on an ideal ring); the stored
+    values' covariance is σ²·G·Gᵀ."""
+    point = _ideal_jog_point(diameter, ball_diameter)
+    probe = ProbeRecord(ball_diameter=ball_diameter)
+    keys = ("X+", "X-", "Y+", "Y-")
+
+    def stored(pt: RingCalibrationPoint) -> FloatArray:
+        if estimator == "ls":
+            record, _ = calibrate_ring(pt, probe, PLANES["G17"], frame=frame)
+        elif estimator == "calibrate_radius":
+            record, _ = calibrate_radius(pt, probe, PLANES["G17"])
+        else:
+            raise ValueError(f"estimator must be 'ls' or 'calibrate_radius', got {estimator!r}")
+        rho = [-record.trigger[k] if k.endswith("+") else record.trigger[k] for k in keys]
+        return np.array([record.skew[0], record.skew[1], *rho])
+
+    base = stored(point)
+    eps = 1e-6
+    cols = []
+    passes = (point.search, *point.passes)
+    for n_pass, ring_pass in enumerate(passes):
+        for key in keys:
+            d = _key_direction(key, PLANES["G17"])
+            moved = dict(ring_pass.rec)
+            moved[key] = moved[key] + eps * d
+            new = [p if i != n_pass else RingPass(p.spindle_angle, moved) for i, p in enumerate(passes)]
+            cols.append((stored(RingCalibrationPoint(diameter, new[0], (new[1], new[2]))) - base) / eps)
+    return {"matrix": np.column_stack(cols), "rows": ("skew_X", "skew_Y", *[f"rho_{k}" for k in keys])}
+
+
+def setup_noise_bound(sigma: float, *, t1: float = 30.0, t2: float = 150.0, u3: float = 40.0,
+                      rotation_deg: float = 0.0, standoff: float = 0.0, estimator: str = "ls",
+                      length_calibration: float = 1.0) -> dict[str, Any]:
+    """Best-estimator noise bound of a set-up: ring calibration (JOG program, 12 touches) +
+    length calibration + right-angled outside corner, position 1 (3 touches: P1, P2 travel +Y,
+    P3 travel +X) + Z edge (1 touch), noise σ per touch along its travel (docs/noise-bound.md).
+
+    Corner frame (origin at the corner, reference edge along +a', part turned by ``rotation_deg``
+    against the machine axes): P1, P2 start at a' = t1, t2 and P3 at o' = u3, each ``standoff``
+    in front of its edge (the flow tests: t1 = 30, t2 = 150, u3 = 40, standoff 12), so the
+    contacts lie at t_i + standoff·tanγ and u3 − standoff·tanγ. ``estimator``: the calibration
+    ("ls" = calibrate_ring, "calibrate_radius" = the 0°-pass values). ``length_calibration``:
+    variance of L1 in σ² (one touch: 1).
+
+    Per corner touch i with edge normal n̂_i (into the material) and travel d̂_i (cosθ = n̂·d̂):
+    the shift of the found edge along n̂_i is ξ_i = n̂_i·Δe + cosθ·(Δρ(d̂_i) + ν_i) (skew error Δe,
+    trigger error Δρ from the calibration's linear response, ν_i the touch noise). Then
+
+        δθ = (ξ2 − ξ1)/L,  δo' = (t2·ξ1 − t1·ξ2)/L,  δa' = ξ3 + u3·δθ,  δ(X, Y) = R(γ)·(δa', δo'),
+        δZ = ν_Z − ν_L.
+
+    Returns ``std`` and ``mean_abs`` (std·√(2/π): what a mean of |error| over seeds estimates)
+    per machine axis in mm, ``rotation_std`` / ``rotation_mean_abs`` in rad, the covariance of
+    (X, Y, θ) and the part the calibration contributes.
+    """
+    if not (np.isfinite(sigma) and sigma >= 0.0):
+        raise ValueError(f"sigma must be >= 0, got {sigma}")
+    g = np.radians(rotation_deg)
+    shift = standoff * np.tan(g)
+    t1c, t2c, u3c = t1 + shift, t2 + shift, u3 - shift
+    length = float(t2c - t1c)
+    if length == 0.0:
+        raise ValueError("P1 and P2 must differ (t1 != t2)")
+    jac = calibration_jacobian(estimator)["matrix"]          # (6, 12): skew X/Y, ρ X+ X− Y+ Y−
+    rot = np.array([[np.cos(g), -np.sin(g)], [np.sin(g), np.cos(g)]])
+    n1, n2 = rot @ np.array([0.0, 1.0]), rot @ np.array([1.0, 0.0])
+    travel = {"Y+": np.array([0.0, 1.0]), "X+": np.array([1.0, 0.0])}
+    row = {"X+": 2, "Y+": 4}
+    # ξ = A_cal·ν_cal + A_touch·ν_touch over (12 calibration touches, P1, P2, P3)
+    a_cal = np.zeros((3, jac.shape[1]))
+    a_touch = np.zeros((3, 3))
+    for i, (normal, key) in enumerate(((n1, "Y+"), (n1, "Y+"), (n2, "X+"))):
+        cos_t = float(normal @ travel[key])
+        a_cal[i] = normal @ jac[0:2] + cos_t * jac[row[key]]
+        a_touch[i, i] = cos_t
+    # (δa', δo', δθ) from ξ
+    m = np.array([[-u3c / length, u3c / length, 1.0],
+                  [t2c / length, -t1c / length, 0.0],
+                  [-1.0 / length, 1.0 / length, 0.0]])
+    big = np.zeros((3, 3))
+    big[:2, :2] = rot
+    big[2, 2] = 1.0
+    cov_cal = big @ m @ (a_cal @ a_cal.T) @ m.T @ big.T
+    cov_touch = big @ m @ (a_touch @ a_touch.T) @ m.T @ big.T
+    cov = sigma * sigma * (cov_cal + cov_touch)
+    var_z = sigma * sigma * (1.0 + float(length_calibration))
+    std = {"X": float(np.sqrt(cov[0, 0])), "Y": float(np.sqrt(cov[1, 1])), "Z": float(np.sqrt(var_z))}
+    k = float(np.sqrt(2.0 / np.pi))
+    rot_std = float(np.sqrt(cov[2, 2]))
+    return {"std": std, "mean_abs": {a: k * v for a, v in std.items()},
+            "rotation_std": rot_std, "rotation_mean_abs": k * rot_std,
+            "covariance_xy_rotation": cov,
+            "calibration_part": {"X": float(sigma * sigma * cov_cal[0, 0]), "Y": float(sigma * sigma * cov_cal[1, 1])},
+            "estimator": estimator, "sigma": float(sigma),
+            "layout": {"t1": float(t1c), "t2": float(t2c), "u3": float(u3c), "rotation_deg": float(rotation_deg)}}

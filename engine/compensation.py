@@ -10,17 +10,23 @@ the ball centre (fits use it), the surface point is the same either way.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
+import numpy.typing as npt
 
 from engine.frames import Frame, rot_z
 from engine.planes import PLANES, Plane
-from engine.types import ProbeRecord, Touch
+from engine.types import FloatArray, ProbeRecord, Touch
+
+if TYPE_CHECKING:                      # engine.lobing needs nothing from here at run time
+    from engine.lobing import LobingMap
 
 _AXES = ("X", "Y", "Z")
 _PARALLEL_TOL = 1e-9
 
 
-def _unit(direction) -> np.ndarray:
+def _unit(direction: npt.ArrayLike) -> FloatArray:
     d = np.asarray(direction, dtype=float)
     if d.shape != (3,):
         raise ValueError(f"direction must have shape (3,), got {d.shape}")
@@ -30,7 +36,7 @@ def _unit(direction) -> np.ndarray:
     return d / norm
 
 
-def parallel_axis(direction_wcs) -> tuple[int, float] | None:
+def parallel_axis(direction_wcs: npt.ArrayLike) -> tuple[int, float] | None:
     """(axis index j, sign σ) when ``direction_wcs`` is axis-parallel within 1e-9, else None."""
     d = _unit(direction_wcs)
     j = int(np.argmax(np.abs(d)))
@@ -52,7 +58,7 @@ def effective_radius(probe: ProbeRecord) -> float:
     return probe.ball_diameter / 2.0
 
 
-def centre_trigger_value(probe: ProbeRecord, direction_wcs, plane: Plane | None = None) -> float:
+def centre_trigger_value(probe: ProbeRecord, direction_wcs: npt.ArrayLike, plane: Plane | None = None) -> float:
     """Axis-parallel trigger value relative to the ball centre: c_j − s_j (measuring-math §5.1).
 
     Stored values refer to the reference point; with ``length_to_tip`` the centre lies r above
@@ -65,7 +71,7 @@ def centre_trigger_value(probe: ProbeRecord, direction_wcs, plane: Plane | None 
     key = trigger_key(j, sign)
     r_nominal = probe.ball_diameter / 2.0
     if key not in probe.trigger:
-        return -sign * r_nominal              # §5.1 ideal probe
+        return -sign * r_nominal              # measuring-math §5.1 ideal probe
     shift = 0.0
     if probe.length_to_tip:
         infeed_unit = (plane or PLANES["G17"]).infeed_unit
@@ -73,15 +79,15 @@ def centre_trigger_value(probe: ProbeRecord, direction_wcs, plane: Plane | None 
     return float(probe.trigger[key]) + shift
 
 
-def trigger_radius(probe: ProbeRecord, direction_wcs, plane: Plane | None = None) -> float:
-    """|t(dir)| (ball-centre relative) for axis-parallel directions, ρ otherwise (§5.3 line shift)."""
+def trigger_radius(probe: ProbeRecord, direction_wcs: npt.ArrayLike, plane: Plane | None = None) -> float:
+    """|t(dir)| (ball-centre relative) for axis-parallel directions, ρ otherwise (measuring-math §5.3 line shift)."""
     if parallel_axis(direction_wcs) is None:
         return effective_radius(probe)
     return abs(centre_trigger_value(probe, direction_wcs, plane))
 
 
-def skew_in_wcs(probe: ProbeRecord, wcs2bcs: Frame, spindle_angle_deg: float = 0.0) -> np.ndarray:
-    """Skew e (ball centre − spindle axis) as a WCS vector (measuring-math §5.2, §1.7).
+def skew_in_wcs(probe: ProbeRecord, wcs2bcs: Frame, spindle_angle_deg: float = 0.0) -> FloatArray:
+    """Skew e (ball centre − spindle axis) as a WCS vector (measuring-math §5.2, measuring-math §1.7).
 
     Machine X/Y skew at spindle 0°, turned with SPOS about the tool axis Z: e(φ) = Rz(φ)·e,
     then into the WCS as a direction (BCS = MCS, no kinematic transformation).
@@ -90,28 +96,43 @@ def skew_in_wcs(probe: ProbeRecord, wcs2bcs: Frame, spindle_angle_deg: float = 0
     return wcs2bcs.dir_parent2child(rot_z(spindle_angle_deg) @ e_mcs)
 
 
-def make_touch(rec_wcs, direction_wcs, probe: ProbeRecord, plane: Plane, skew_wcs=None,
-               latched_mcs=None) -> Touch:
-    """One compensated probing (measuring-math §5.2, §5.3).
+def make_touch(rec_wcs: npt.ArrayLike, direction_wcs: npt.ArrayLike, probe: ProbeRecord, plane: Plane,
+               skew_wcs: npt.ArrayLike | None = None, latched_mcs: npt.ArrayLike | None = None, *, lobing: LobingMap | None = None, spindle_angle: float = 0.0,
+               wcs2bcs: Frame | None = None) -> Touch:
+    """One compensated probing (measuring-math §5.2, measuring-math §5.3).
 
-    ball centre c = rec (+ r·p̂ when length_to_tip, §0.1) + e;
-    axis-parallel along j, sign σ: s = c with s_j = c_j − t_centre(σ, j)  (§5.3);
-    otherwise s = c + ρ·d̂  (§5.3, point-wise).
+    ball centre c = rec (+ r·p̂ when length_to_tip, measuring-math §0.1) + e;
+    axis-parallel along j, sign σ: s = c with s_j = c_j − t_centre(σ, j)  (measuring-math §5.3);
+    otherwise s = c + ρ·d̂  (measuring-math §5.3, point-wise).
+
+    ``lobing`` (engine.lobing.LobingMap, optional): the direction-dependent effective radius of
+    an n-direction calibration; then every direction uses s = c + ρ(θ)·d̂ with θ the travel
+    direction in the map's frame at SPOS ``spindle_angle`` (``wcs2bcs``: measuring WCS -> BCS;
+    the infeed part blends with the record's current |t(−p)|). ``skew_wcs`` must then be the
+    map's skew at that spindle angle (skew_in_wcs of the record it was stored with). Without
+    ``lobing`` the result is exactly the record-based one above; ``probe.lobing`` is the
+    default (the map stored with the record).
     """
     rec = np.asarray(rec_wcs, dtype=float)
     if rec.shape != (3,):
         raise ValueError(f"rec_wcs must have shape (3,), got {rec.shape}")
+    if lobing is None:
+        lobing = probe.lobing
     d_hat = _unit(direction_wcs)
     skew = np.zeros(3) if skew_wcs is None else np.asarray(skew_wcs, dtype=float)
     centre = rec + skew
     if probe.length_to_tip:
-        centre = centre + (probe.ball_diameter / 2.0) * plane.infeed_unit   # §0.1 tip -> centre
+        centre = centre + (probe.ball_diameter / 2.0) * plane.infeed_unit   # measuring-math §0.1 tip -> centre
     axis = parallel_axis(d_hat)
-    if axis is not None:
+    if lobing is not None:
+        axial = abs(centre_trigger_value(probe, -plane.infeed_unit, plane))
+        rho = lobing.radius_for(d_hat, spindle_angle, wcs2bcs, axial_radius=axial)
+        surface = centre + rho * d_hat                                       # engine.lobing
+    elif axis is not None:
         j, _sign = axis
         surface = centre.copy()
-        surface[j] = centre[j] - centre_trigger_value(probe, d_hat, plane)   # §5.3 s_j = c_j − t
+        surface[j] = centre[j] - centre_trigger_value(probe, d_hat, plane)   # measuring-math §5.3 s_j = c_j − t
     else:
-        surface = centre + effective_radius(probe) * d_hat                  # §5.3 s = c + ρ·d̂
+        surface = centre + effective_radius(probe) * d_hat                  # measuring-math §5.3 s = c + ρ·d̂
     latched = None if latched_mcs is None else np.asarray(latched_mcs, dtype=float)
     return Touch(ball_centre=centre, direction=d_hat, surface=surface, latched_mcs=latched)

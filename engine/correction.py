@@ -1,4 +1,4 @@
-"""Zero-offset correction: write a measured feature into a target frame (spec §2, §4).
+"""Zero-offset correction: write a measured feature into a target frame (jog-measuring §2, jog-measuring §4).
 
 Systems: measuring WCS --chain--> BCS <--target_parent2bcs-- target parent <--target frame--
 target child. Setpoints and the setpoint angle are read in the target's child system (= the
@@ -9,9 +9,9 @@ Rules (the product's decisions, see the module's report):
 - Rotation first (coordinate rotation about the angle axis, or orient plane), then translation
   ``T_new = T_old + R_new·d`` with d non-zero only on the determined axes (measuring-math §2.2,
   jog-measuring §2.5.1 [I]); so undetermined translation components (in the new child axes)
-  stay, and a pure rotation turns about the child origin (translation kept, jog §2.9).
-- A translation goes into the coarse offset, fine cleared (jog §1.7, §4.4; measuring-math §2.1).
-- Rotary-axis angle correction: offset_new = offset_old + (measured − setpoint) (jog §11 Q8,
+  stay, and a pure rotation turns about the child origin (translation kept, jog-measuring §2.9).
+- A translation goes into the coarse offset, fine cleared (jog-measuring §1.7, jog-measuring §4.4; measuring-math §2.1).
+- Rotary-axis angle correction: offset_new = offset_old + (measured − setpoint) (jog-measuring §11 Q8,
   s = +1). DIN 66217: a rotary *table* turning + rotates the part clockwise seen from +axis
   (the tool's motion relative to the part is right-handed), so turning the table by
   +(measured − setpoint) brings the edge from the measured to the setpoint angle.
@@ -22,13 +22,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
+from engine import alarms
 from engine.frames import Frame, FrameChain, rot_axis, rot_x, rot_y, rot_z, rpy_from_matrix
 from engine.planes import Plane, axis_index
-from engine.types import FeatureFix, MeasuringError
+from engine.types import FeatureFix, FloatArray, MeasuringError
 
 GLOBAL_BASIC_PREFIX = "NCBASIC"
-ALARM_ZO_NOT_ALLOWED = 61321   # "check ZO number" (manual alarm list; measuring-math §2.1)
 
 
 @dataclass(frozen=True)
@@ -40,7 +41,7 @@ class Correction:
     rotary_move: float | None = None  # deg the rotary axis must turn to align the part
 
     def tilts_infeed(self, plane: Plane, tol_deg: float = 1e-7) -> bool:
-        """True when the infeed axis direction changed: probe re-alignment needed (jog §6.2 cond. 2)."""
+        """True when the infeed axis direction changed: probe re-alignment needed (jog-measuring §6.2 cond. 2)."""
         p = plane.infeed_unit
         old, new = self.before.rotation @ p, self.after.rotation @ p
         angle = np.degrees(np.arctan2(np.linalg.norm(np.cross(old, new)), old @ new))
@@ -61,8 +62,8 @@ def _signed_axis(name: str) -> tuple[str, float]:
     return name.lstrip("+"), 1.0
 
 
-def alpha_beta_from_normal(normal, plane: Plane) -> tuple[float, float]:
-    """(alpha about a, beta about o) in deg with Rot_o(beta)·Rot_a(alpha)·ê_p = n̂ (jog §2.9).
+def alpha_beta_from_normal(normal: npt.ArrayLike, plane: Plane) -> tuple[float, float]:
+    """(alpha about a, beta about o) in deg with Rot_o(beta)·Rot_a(alpha)·ê_p = n̂ (jog-measuring §2.9).
 
     G17: alpha = asin(−n_y), beta = atan2(n_x, n_z); G18/G19 with (a, o, p) permuted.
     """
@@ -71,20 +72,20 @@ def alpha_beta_from_normal(normal, plane: Plane) -> tuple[float, float]:
     if n.shape != (3,) or not np.isfinite(norm) or norm == 0.0:
         raise ValueError(f"normal must be a finite non-zero 3-vector, got {normal!r}")
     n_a, n_o, n_p = plane.to_aop(n / norm)
-    alpha = np.degrees(np.arcsin(np.clip(-n_o, -1.0, 1.0)))   # jog §2.9
-    beta = np.degrees(np.arctan2(n_a, n_p))                     # jog §2.9
+    alpha = np.degrees(np.arcsin(np.clip(-n_o, -1.0, 1.0)))   # jog-measuring §2.9
+    beta = np.degrees(np.arctan2(n_a, n_p))                     # jog-measuring §2.9
     return float(alpha), float(beta)
 
 
-def _orient_rotation(rotation_old: np.ndarray, normal_in_parent: np.ndarray, plane: Plane) -> np.ndarray:
+def _orient_rotation(rotation_old: FloatArray, normal_in_parent: FloatArray, plane: Plane) -> FloatArray:
     """New child2parent rotation whose +p axis is the normal, keeping the rotation about p.
 
     In (a, o, p) coordinates R = Rot_p(gamma)·Rot_o(beta)·Rot_a(alpha) (Siemens RPY order,
-    measuring-math §0.2, permuted per jog §2.9); gamma is taken from the old frame and kept.
+    measuring-math §0.2, permuted per jog-measuring §2.9); gamma is taken from the old frame and kept.
     """
     m = plane.aop2xyz
     rot_old_aop = m.T @ rotation_old @ m
-    gamma = float(np.degrees(np.arctan2(rot_old_aop[1, 0], rot_old_aop[0, 0])))  # §0.2 extraction
+    gamma = float(np.degrees(np.arctan2(rot_old_aop[1, 0], rot_old_aop[0, 0])))  # measuring-math §0.2 extraction
     n_aop = m.T @ normal_in_parent
     n_unrotated = rot_z(-gamma) @ n_aop
     alpha, beta = alpha_beta_from_normal(plane.to_xyz(n_unrotated), plane)
@@ -105,10 +106,10 @@ def correct(fix: FeatureFix, *, setpoints: dict[str, float], setpoint_angle: flo
 
     meas2bcs: Frame = chain.wcs2bcs
 
-    def dir_meas2parent(d_in_meas) -> np.ndarray:
+    def dir_meas2parent(d_in_meas: npt.ArrayLike) -> FloatArray:
         return target_parent2bcs.dir_parent2child(meas2bcs.dir_child2parent(d_in_meas))
 
-    def p_meas2parent(p_in_meas) -> np.ndarray:
+    def p_meas2parent(p_in_meas: npt.ArrayLike) -> FloatArray:
         return target_parent2bcs.parent2child(meas2bcs.child2parent(p_in_meas))
 
     rotation_old = target_frame.rotation
@@ -122,22 +123,22 @@ def correct(fix: FeatureFix, *, setpoints: dict[str, float], setpoint_angle: flo
     is_global = target.upper().startswith(GLOBAL_BASIC_PREFIX)
 
     if fix.normal is not None and fix.angle is not None:
-        raise MeasuringError(61403, "a feature fix cannot carry both a plane normal and an angle")
+        raise MeasuringError(alarms.FRAME_INTERNAL, "a feature fix cannot carry both a plane normal and an angle")
 
     if fix.normal is not None and wants_angle:
         if is_global:
-            raise MeasuringError(ALARM_ZO_NOT_ALLOWED,
-                                 f"{target}: a global basic frame cannot take a rotation (jog §4.2)")
+            raise MeasuringError(alarms.ZO_NUMBER,
+                                 f"{target}: a global basic frame cannot take a rotation (jog-measuring §4.2)")
         normal_in_parent = dir_meas2parent(fix.normal)
         normal_in_parent = normal_in_parent / np.linalg.norm(normal_in_parent)
-        rotation_new = _orient_rotation(rotation_old, normal_in_parent, plane)   # jog §2.9
+        rotation_new = _orient_rotation(rotation_old, normal_in_parent, plane)   # jog-measuring §2.9
         rotation_changed = True
 
     elif fix.angle is not None and wants_angle:
         if is_global:
-            raise MeasuringError(ALARM_ZO_NOT_ALLOWED,
+            raise MeasuringError(alarms.ZO_NUMBER,
                                  f"{target}: a global basic frame cannot take an angle correction "
-                                 "(jog §4.2, §11 Q21)")
+                                 "(jog-measuring §4.2, jog-measuring §11 Q21)")
         k_name, k_sign = _signed_axis(fix.angle_axis or plane.infeed)
         r_name = fix.reference_axis or plane.first
         e_k = np.zeros(3)
@@ -146,12 +147,12 @@ def correct(fix: FeatureFix, *, setpoints: dict[str, float], setpoint_angle: flo
         e_r[axis_index(r_name)] = 1.0
         if abs(e_k @ e_r) > 0.0:
             raise ValueError(f"reference axis {r_name} must differ from the angle axis {k_name}")
-        e_90 = np.cross(e_k, e_r)                 # +90° from the reference axis about k (§0.1)
+        e_90 = np.cross(e_k, e_r)                 # +90° from the reference axis about k (measuring-math §0.1)
         theta = np.radians(fix.angle)
         u_meas = np.cos(theta) * e_r + np.sin(theta) * e_90
         u_child = rotation_old.T @ dir_meas2parent(u_meas)   # measured direction, old child system
         theta_child = float(np.degrees(np.arctan2(u_child @ e_90, u_child @ e_r)))
-        delta = _wrap180(theta_child - (setpoint_angle or 0.0))   # D = actual − setpoint (§0.1)
+        delta = _wrap180(theta_child - (setpoint_angle or 0.0))   # D = actual − setpoint (measuring-math §0.1)
         if angle_correction == "rotation":
             # measuring-math §2.2: R_new = R_old·Rot_k(Δθ)
             rotation_new = rotation_old @ rot_axis(k_name, k_sign * delta)
@@ -160,7 +161,7 @@ def correct(fix: FeatureFix, *, setpoints: dict[str, float], setpoint_angle: flo
             axis = str(angle_correction)
             if axis.upper() in ("X", "Y", "Z"):
                 raise ValueError(f"angle correction axis must be a rotary axis, got {axis!r}")
-            rotary[axis] = rotary.get(axis, 0.0) + delta        # jog §2.5.2, §11 Q8 (s = +1)
+            rotary[axis] = rotary.get(axis, 0.0) + delta        # jog-measuring §2.5.2, jog-measuring §11 Q8 (s = +1)
             rotary_axis, rotary_move = axis, delta
 
     coarse, fine = target_frame.coarse, target_frame.fine
@@ -174,9 +175,9 @@ def correct(fix: FeatureFix, *, setpoints: dict[str, float], setpoint_angle: flo
         d = np.zeros(3)
         for axis in determined:
             j = axis_index(axis)
-            d[j] = point_child[j] - float(setpoints.get(axis, 0.0))      # jog §2.5.1 d = c_a − s
+            d[j] = point_child[j] - float(setpoints.get(axis, 0.0))      # jog-measuring §2.5.1 d = c_a − s
         coarse = translation_old + rotation_new @ d        # measuring-math §2.2 T_new = T + R·d
-        fine = np.zeros(3)                                 # jog §4.4: coarse, fine cleared
+        fine = np.zeros(3)                                 # jog-measuring §4.4: coarse, fine cleared
 
     rot = rpy_from_matrix(rotation_new) if rotation_changed else target_frame.rot
     after = Frame(coarse=coarse, fine=fine, rot=rot, rotary=tuple(rotary.items()))

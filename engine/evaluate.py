@@ -1,29 +1,33 @@
-"""Evaluation of the stored points of every workpiece task (spec/jog-measuring.md §2.5-§2.9).
+"""Evaluation of the stored points of every workpiece task (spec/jog-measuring.md §2.5-jog-measuring §2.9).
 
-``evaluate(task, params, points, plane, probe)`` -> ``TaskResult``: ``values`` carries the
+``evaluate(task: str, params: dict[str, Any], points: Sequence[StoredPoint], plane: Plane,
+        probe: ProbeRecord)`` -> ``TaskResult``: ``values`` carries the
 design.md §4 result keys (points as objects keyed by the plane's axis names, angles in deg),
 ``fix`` tells engine.correction what was measured, in the measuring WCS.
 
 Conventions (the product's decisions; see the docstrings of the task functions):
-- Surfaces: edge positions are the touch's surface coordinate (measuring-math §5.3, §9.1).
+- Surfaces: edge positions are the touch's surface coordinate (measuring-math §5.3, measuring-math §9.1).
 - Straight edges probed for an intersection (corners): the line through the ball centres,
-  shifted by ρ_dir = compensation.trigger_radius along its normal towards the material
-  (measuring-math §5.3 [I], §12.3); exact for inclined edges.
+  shifted by ρ_dir = touch_radius (the touch's compensation) along its normal towards the material
+  (measuring-math §5.3 [I], measuring-math §12.3); exact for inclined edges.
 - Circles from 4 touches: the CYCLE977 chord rule in the probing directions' basis
   (measuring-math §8.3): centre from the mid-points of both chords, diameter from the second
   chord (which runs through the found centre). Exact for any chord offset of the first pair.
 - Angles: right-hand rotation about the axis named in ``fix.angle_axis`` from the reference
   axis (measuring-math §0.1). Straight edges (align edge, corners) are lines without a
   direction: their angle is folded into (−90°, 90°]. Hole patterns use the directed line
-  (2 holes P1→P2, 3 holes P0→P1, 4 holes P1→P2; jog §11 Q6) in (−180°, 180°].
+  (2 holes P1→P2, 3 holes P0→P1, 4 holes P1→P2; jog-measuring §11 Q6) in (−180°, 180°].
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
+from engine import alarms
 from engine.compensation import trigger_radius
 from engine.correction import alpha_beta_from_normal
 from engine.fit import LineFit, fit_circle, fit_line, fit_plane, intersect_lines
@@ -32,6 +36,7 @@ from engine.types import (
     CirclePoint,
     EdgePoint,
     FeatureFix,
+    FloatArray,
     MeasuringError,
     ProbeRecord,
     RectPoint,
@@ -43,28 +48,28 @@ from engine.types import (
 _AXES = ("X", "Y", "Z")
 _COINCIDENT_TOL = 1e-9   # mm: points closer than this are "identical" (alarm 61367)
 
-# Which line the angle of a hole pattern measures (jog §11 Q6): indices into [P0, P1, P2, ...].
+# Which line the angle of a hole pattern measures (jog-measuring §11 Q6): indices into [P0, P1, P2, ...].
 HOLE_ANGLE_LINE = {2: (1, 2), 3: (0, 1), 4: (1, 2)}
 
 
 # --- small helpers ------------------------------------------------------------------------
 
-def _ao(plane: Plane, xyz) -> np.ndarray:
+def _ao(plane: Plane, xyz: npt.ArrayLike) -> FloatArray:
     """(a, o) plane coordinates of a WCS vector."""
     return plane.to_aop(xyz)[:2]
 
 
-def _plane_point(plane: Plane, ao) -> dict[str, float]:
+def _plane_point(plane: Plane, ao: FloatArray | Sequence[float]) -> dict[str, float]:
     """{first: a, second: o} (design.md §4: a point keyed by the plane's axis names)."""
     return {plane.first: float(ao[0]), plane.second: float(ao[1])}
 
 
-def _point3(plane: Plane, xyz) -> dict[str, float]:
+def _point3(plane: Plane, xyz: npt.ArrayLike) -> dict[str, float]:
     aop = plane.to_aop(xyz)
     return {name: float(v) for name, v in zip(plane.axes, aop, strict=True)}
 
 
-def _xyz(plane: Plane, ao, p: float) -> np.ndarray:
+def _xyz(plane: Plane, ao: FloatArray | Sequence[float], p: float) -> FloatArray:
     return plane.to_xyz(np.array([ao[0], ao[1], p], dtype=float))
 
 
@@ -77,20 +82,20 @@ def _fold90(deg: float) -> float:
     return deg
 
 
-def _angle_ao(vec_ao) -> float:
-    """Angle of a plane vector from the 1st plane axis, right-hand about the infeed (§0.1)."""
+def _angle_ao(vec_ao: FloatArray | Sequence[float]) -> float:
+    """Angle of a plane vector from the 1st plane axis, right-hand about the infeed (jog-measuring §0.1)."""
     return float(np.degrees(np.arctan2(vec_ao[1], vec_ao[0])))
 
 
-def _unit2(v) -> np.ndarray:
-    v = np.asarray(v, dtype=float)
-    n = float(np.linalg.norm(v))
+def _unit2(v: npt.ArrayLike) -> FloatArray:
+    u = np.asarray(v, dtype=float)
+    n = float(np.linalg.norm(u))
     if n == 0.0:
         raise ValueError("zero direction in the plane")
-    return v / n
+    return u / n
 
 
-def _wants_angle(params: dict, default: str) -> bool:
+def _wants_angle(params: dict[str, Any], default: str) -> bool:
     value = params.get("angle_correction", default)
     return value not in (None, "", "none")
 
@@ -106,7 +111,7 @@ def _edge_points(task: str, points: Sequence[StoredPoint], n: int) -> list[Touch
     return touches
 
 
-def _measuring_axis(params: dict, touch: Touch) -> str:
+def _measuring_axis(params: dict[str, Any], touch: Touch) -> str:
     axis = params.get("axis")
     if axis:
         axis_index(axis)
@@ -120,8 +125,17 @@ def _touch_values(plane: Plane, touches: Sequence[Touch]) -> list[dict[str, floa
 
 # --- circles and rectangles from their 4 touches -------------------------------------------
 
+def touch_radius(touch: Touch, probe: ProbeRecord | None, plane: Plane) -> float:
+    """ρ of the touch's direction (measuring-math §5.3): the record's axis-parallel trigger value
+    |t|, or with a lobing map (engine.lobing) the ρ(θ) make_touch applied, (s − c)·d̂."""
+    probe = probe or ProbeRecord()
+    if probe.lobing is None:
+        return trigger_radius(probe, touch.direction, plane)
+    return float((np.asarray(touch.surface, float) - np.asarray(touch.ball_centre, float)) @ touch.direction)
+
+
 def circle_from_touches(touches: Sequence[Touch], plane: Plane, kind: str,
-                        probe: ProbeRecord | None = None) -> tuple[np.ndarray, float]:
+                        probe: ProbeRecord | None = None) -> tuple[FloatArray, float]:
     """(centre (3,), diameter) of a bore (``kind`` "hole") or shaft ("spigot").
 
     4 touches P1 +u, P2 −u, P3 +v, P4 −v (u ⟂ v, any probing angle; travel directions):
@@ -134,7 +148,7 @@ def circle_from_touches(touches: Sequence[Touch], plane: Plane, kind: str,
     if kind not in ("hole", "spigot"):
         raise ValueError(f"kind must be 'hole' or 'spigot', got {kind!r}")
     if len(touches) < 3:
-        raise MeasuringError(61317, f"a circle needs 3 or more touches, got {len(touches)}")
+        raise MeasuringError(alarms.CIRCLE_PARAMETERS, f"a circle needs 3 or more touches, got {len(touches)}")
     height = float(np.mean([plane.to_aop(t.surface)[2] for t in touches]))
     if len(touches) == 4:
         u = _unit2(_ao(plane, touches[0].direction))
@@ -143,25 +157,24 @@ def circle_from_touches(touches: Sequence[Touch], plane: Plane, kind: str,
         d3 = _unit2(_ao(plane, touches[3].direction))
         if abs(u @ v) < 1e-9 and np.allclose(d1, -u, atol=1e-9) and np.allclose(d3, -v, atol=1e-9):
             s = [_ao(plane, t.surface) for t in touches]
-            centre_u = 0.5 * (s[0] + s[1]) @ u          # §8.3 centre_a = (s1 + s2)/2
-            centre_v = 0.5 * (s[2] + s[3]) @ v          # §8.3 centre_o = (s3 + s4)/2
-            chord = (s[2] - s[3]) @ v                   # §8.3 bore D = s3 − s4
+            centre_u = 0.5 * (s[0] + s[1]) @ u          # jog-measuring §8.3 centre_a = (s1 + s2)/2
+            centre_v = 0.5 * (s[2] + s[3]) @ v          # jog-measuring §8.3 centre_o = (s3 + s4)/2
+            chord = (s[2] - s[3]) @ v                   # jog-measuring §8.3 bore D = s3 − s4
             diameter = chord if kind == "hole" else -chord   # shaft D = s4 − s3
             if diameter <= 0.0:
-                raise MeasuringError(61316, f"{kind}: non-positive diameter {diameter:.6f}")
+                raise MeasuringError(alarms.CIRCLE_UNDETERMINED, f"{kind}: non-positive diameter {diameter:.6f}")
             return _xyz(plane, centre_u * u + centre_v * v, height), float(diameter)
     centres = np.array([_ao(plane, t.ball_centre) for t in touches])
     circle = fit_circle(centres)                        # CYCLE116 on the ball centres
-    rho = float(np.mean([trigger_radius(probe or ProbeRecord(), t.direction, plane)
-                         for t in touches]))
-    radius = circle.radius + rho if kind == "hole" else circle.radius - rho   # §5.3 [I]
+    rho = float(np.mean([touch_radius(t, probe, plane) for t in touches]))
+    radius = circle.radius + rho if kind == "hole" else circle.radius - rho   # jog-measuring §5.3 [I]
     if radius <= 0.0:
-        raise MeasuringError(61316, f"{kind}: non-positive radius {radius:.6f}")
+        raise MeasuringError(alarms.CIRCLE_UNDETERMINED, f"{kind}: non-positive radius {radius:.6f}")
     return _xyz(plane, circle.center, height), 2.0 * radius
 
 
 def rect_from_touches(touches: Sequence[Touch], plane: Plane, kind: str
-                      ) -> tuple[np.ndarray, float, float]:
+                      ) -> tuple[FloatArray, float, float]:
     """(centre (3,), length along the 1st plane axis, width along the 2nd) of a rectangle.
 
     4 touches: a pair of opposite travels along one plane axis and a pair along the other
@@ -176,10 +189,10 @@ def rect_from_touches(touches: Sequence[Touch], plane: Plane, kind: str
     pairs = []
     for i, j in ((0, 1), (2, 3)):
         u = _unit2(_ao(plane, touches[i].direction))
-        span = (s[i] - s[j]) @ u                           # §8.3 inner: s1 − s2
+        span = (s[i] - s[j]) @ u                           # jog-measuring §8.3 inner: s1 − s2
         span = span if kind == "pocket" else -span         # outer: s2 − s1
         if span <= 0.0:
-            raise MeasuringError(61316, f"{kind}: non-positive span {span:.6f}")
+            raise MeasuringError(alarms.CIRCLE_UNDETERMINED, f"{kind}: non-positive span {span:.6f}")
         pairs.append((u, 0.5 * (s[i] + s[j]) @ u, span))
     (u1, c1, span1), (u2, c2, span2) = pairs
     if abs(u1 @ u2) > 1e-9:
@@ -194,7 +207,7 @@ def rect_from_touches(touches: Sequence[Touch], plane: Plane, kind: str
 
 
 def _circle_of(point: StoredPoint, plane: Plane, kind: str, probe: ProbeRecord
-               ) -> tuple[np.ndarray, float]:
+               ) -> tuple[FloatArray, float]:
     if not isinstance(point, CirclePoint):
         raise ValueError(f"expected a CirclePoint, got {type(point).__name__}")
     if len(point.touches) >= 3:
@@ -204,44 +217,54 @@ def _circle_of(point: StoredPoint, plane: Plane, kind: str, probe: ProbeRecord
 
 # --- edges ------------------------------------------------------------------------------------
 
-def _edge_set(task, params, points, plane, probe) -> TaskResult:
-    """Set edge (jog §2.5.1): edge position = the touch's surface coordinate on the axis."""
+def evaluate_edge_set(task: str, params: dict[str, Any], points: Sequence[StoredPoint], plane: Plane,
+        probe: ProbeRecord) -> TaskResult:
+    """Set edge (jog-measuring §2.5.1): edge position = the touch's surface coordinate on the axis."""
     (touch,) = _edge_points(task, points, 1)
     axis = _measuring_axis(params, touch)
-    pos = float(touch.surface[axis_index(axis)])                       # §5.3 s_j = c_j − t
+    pos = float(touch.surface[axis_index(axis)])                       # jog-measuring §5.3 s_j = c_j − t
     values = {"position": {axis: pos}, "axis": axis, "points": _touch_values(plane, [touch])}
     return TaskResult(task, values, FeatureFix(position={axis: pos}, point=np.array(touch.surface)))
 
 
-def _edge_align(task, params, points, plane, probe) -> TaskResult:
-    """Align edge (jog §2.5.2): angle of the edge P1→P2 against the reference axis r.
+def evaluate_edge_align(task: str, params: dict[str, Any], points: Sequence[StoredPoint], plane: Plane,
+        probe: ProbeRecord) -> TaskResult:
+    """Align edge (jog-measuring §2.5.2): angle of the edge P1→P2 against the reference axis r.
 
     alpha = atan2(Δm, Δr) of the surface points (spec [I]), signed as the right-hand rotation
     about the third axis k that turns +r onto the edge (measuring-math §11.1: σ = +1 when
     (r, m, k) is cyclic, else −1), folded into (−90°, 90°] because an edge has no direction.
     """
-    t1, t2 = _edge_points(task, points, 2)
+    touches = _edge_points(task, points, max(2, len(points)))
+    t1, t2 = touches[0], touches[-1]
     m = _measuring_axis(params, t1)
     r = params.get("reference_axis") or (plane.second if m == plane.first else plane.first)
     im, ir = axis_index(m), axis_index(r)
     if im == ir:
         raise ValueError(f"reference axis {r} must differ from the measuring axis {m}")
     k = _AXES[3 - im - ir]
-    sigma = 1.0 if (im - ir) % 3 == 1 else -1.0                          # §11.1 cyclic pairs
+    sigma = 1.0 if (im - ir) % 3 == 1 else -1.0                          # measuring-math §11.1 cyclic pairs
     delta = np.asarray(t2.surface, float) - np.asarray(t1.surface, float)
     if abs(delta[ir]) < _COINCIDENT_TOL:
-        raise MeasuringError(61367, "P1 and P2 coincide along the reference axis")
-    alpha = _fold90(float(np.degrees(np.arctan2(sigma * delta[im], delta[ir]))))   # §2.5.2
+        raise MeasuringError(alarms.POINTS_IDENTICAL, "P1 and P2 coincide along the reference axis")
+    quality = {}
+    if len(touches) > 2:       # n points: the least-squares line of the surface points (design.md §9.8)
+        line = fit_line(np.array([[t.surface[ir], t.surface[im]] for t in touches], dtype=float))
+        delta = np.zeros(3)
+        delta[ir], delta[im] = line.direction
+        quality = {"residuals": [float(v) for v in line.residuals], "form_error": float(line.form_error)}
+    alpha = _fold90(float(np.degrees(np.arctan2(sigma * delta[im], delta[ir]))))   # jog-measuring §2.5.2
     values = {"angle": alpha, "measuring_axis": m, "reference_axis": r, "angle_axis": k,
-              "points": _touch_values(plane, [t1, t2])}
+              "points": _touch_values(plane, touches), **quality}
     fix = FeatureFix(point=np.array(t1.surface))
     if _wants_angle(params, "rotation"):
         fix = FeatureFix(angle=alpha, angle_axis=k, reference_axis=r, point=np.array(t1.surface))
     return TaskResult(task, values, fix)
 
 
-def _edge_distance(task, params, points, plane, probe) -> TaskResult:
-    """Distance 2 edges (jog §2.5.3): L = |e2 − e1|, centre (e1 + e2)/2 on the axis."""
+def evaluate_edge_distance(task: str, params: dict[str, Any], points: Sequence[StoredPoint], plane: Plane,
+        probe: ProbeRecord) -> TaskResult:
+    """Distance 2 edges (jog-measuring §2.5.3): L = |e2 − e1|, centre (e1 + e2)/2 on the axis."""
     t1, t2 = _edge_points(task, points, 2)
     axis = _measuring_axis(params, t1)
     j = axis_index(axis)
@@ -255,45 +278,46 @@ def _edge_distance(task, params, points, plane, probe) -> TaskResult:
 
 # --- corners ----------------------------------------------------------------------------------
 
-def _normal_shift(plane: Plane, probe: ProbeRecord, touch: Touch, normal) -> float:
+def _normal_shift(plane: Plane, probe: ProbeRecord, touch: Touch, normal: FloatArray) -> float:
     """Ball-centre-to-surface distance along the edge normal n̂ for an axis-parallel touch.
 
     The overtravel δ = r − |t| (pre-travel + latency path) runs along the probing direction d̂,
     so only δ·cosθ of it (θ = angle between d̂ and n̂) brings the centre nearer the edge:
-    shift = r − δ·cosθ (measuring-math §5.3 / §12.3; equals |t| for θ = 0).
+    shift = r − δ·cosθ (measuring-math §5.3 / measuring-math §12.3; equals |t| for θ = 0).
     """
-    rho = trigger_radius(probe, touch.direction, plane)
+    rho = touch_radius(touch, probe, plane)
     cos_theta = abs(float(_ao(plane, touch.direction) @ normal))
     r_nominal = probe.ball_diameter / 2.0
     return r_nominal - (r_nominal - rho) * cos_theta
 
 
-def _surface_line(plane: Plane, probe: ProbeRecord, touches: Sequence[Touch]) -> tuple[LineFit, list]:
-    """Edge line: fit through the ball centres, shifted by ρ_dir along n̂ (n̂·d̂ > 0) (§5.3 [I])."""
+def _surface_line(plane: Plane, probe: ProbeRecord, touches: Sequence[Touch]) -> tuple[LineFit, list[FloatArray]]:
+    """Edge line: fit through the ball centres, shifted by ρ_dir along n̂ (n̂·d̂ > 0) (jog-measuring §5.3 [I])."""
     centres = [_ao(plane, t.ball_centre) for t in touches]
     for i in range(len(centres) - 1):
         if np.linalg.norm(centres[i + 1] - centres[i]) < _COINCIDENT_TOL:
-            raise MeasuringError(61367, "points P1/P2 or P3/P4 are identical")
+            raise MeasuringError(alarms.POINTS_IDENTICAL, "points P1/P2 or P3/P4 are identical")
     line = fit_line(np.array(centres))
     normal = np.array([-line.direction[1], line.direction[0]])
     travel = np.sum([_ao(plane, t.direction) for t in touches], axis=0)
     if normal @ travel < 0.0:
         normal = -normal
-    shifted = [c + _normal_shift(plane, probe, t, normal) * normal     # §5.3 ρ_dir·n̂
+    shifted = [c + _normal_shift(plane, probe, t, normal) * normal     # jog-measuring §5.3 ρ_dir·n̂
                for c, t in zip(centres, touches, strict=True)]
     return fit_line(np.array(shifted)), shifted
 
 
-def _check_outside(line: LineFit, q_first, q_last, corner, which: str) -> None:
-    """61369 when the corner lies strictly between the points of one edge (§12.3 [M/I])."""
+def _check_outside(line: LineFit, q_first: FloatArray, q_last: FloatArray, corner: FloatArray, which: str) -> None:
+    """61369 when the corner lies strictly between the points of one edge (measuring-math §12.3 [M/I])."""
     length = float(np.linalg.norm(np.asarray(q_last) - np.asarray(q_first)))
     t = float((corner - q_first) @ line.direction) / length
     if 1e-9 < t < 1.0 - 1e-9:
-        raise MeasuringError(61369, f"corner position not unique: it lies between {which}")
+        raise MeasuringError(alarms.CORNER_NOT_UNIQUE, f"corner position not unique: it lies between {which}")
 
 
-def _corner(task, params, points, plane, probe) -> TaskResult:
-    """Right-angled / any corner (jog §2.6, measuring-math §12.3).
+def evaluate_corner(task: str, params: dict[str, Any], points: Sequence[StoredPoint], plane: Plane,
+        probe: ProbeRecord) -> TaskResult:
+    """Right-angled / any corner (jog-measuring §2.6, measuring-math §12.3).
 
     Reference edge L1 through P1, P2; second edge: the perpendicular through P3 (right-angled)
     or the line P3P4 (any). Both from ball centres shifted by ρ_dir towards the material.
@@ -301,7 +325,7 @@ def _corner(task, params, points, plane, probe) -> TaskResult:
     edge -> 61369). Angle = direction of L1 against the 1st plane axis about the infeed,
     folded into (−90°, 90°].
     """
-    right = task == "corner.right"
+    right = len(points) == 3             # right-angled corner: 3 points, any corner: 4
     touches = _edge_points(task, points, 3 if right else 4)
     line1, q12 = _surface_line(plane, probe, touches[:2])
     if right:
@@ -309,24 +333,27 @@ def _corner(task, params, points, plane, probe) -> TaskResult:
         c3 = _ao(plane, touches[2].ball_centre)
         n2 = line1.direction if line1.direction @ _ao(plane, touches[2].direction) > 0 \
             else -line1.direction
-        q3 = c3 + _normal_shift(plane, probe, touches[2], n2) * n2             # §5.3 shift
+        q3 = c3 + _normal_shift(plane, probe, touches[2], n2) * n2             # jog-measuring §5.3 shift
         line2 = LineFit(point=q3, direction=perp)
-        corner = intersect_lines(line1, line2)                                 # §12.3
+        corner = intersect_lines(line1, line2)                                 # measuring-math §12.3
         _check_outside(line1, q12[0], q12[1], corner, "P1 and P2")
     else:
         line2, q34 = _surface_line(plane, probe, touches[2:])
-        corner = intersect_lines(line1, line2)                                 # §12.3
+        corner = intersect_lines(line1, line2)                                 # measuring-math §12.3
         _check_outside(line1, q12[0], q12[1], corner, "P1 and P2")
         _check_outside(line2, q34[0], q34[1], corner, "P3 and P4")
-    angle = _fold90(_angle_ao(line1.direction))                                # §12.3 φ_W
+    angle = _fold90(_angle_ao(line1.direction))                                # measuring-math §12.3 φ_W
     height = float(np.mean([plane.to_aop(t.surface)[2] for t in touches]))
     corner_xyz = _xyz(plane, corner, height)
     values = {"corner": _plane_point(plane, corner), "angle": angle,
               "points": _touch_values(plane, touches)}
     if not right:
         values["angle_2"] = _angle_ao(line2.direction)
-        values["corner_angle"] = float(np.degrees(np.arccos(np.clip(
-            abs(line1.direction @ line2.direction), -1.0, 1.0))))
+        # the angle between the two edges as they leave the corner towards their points
+        # (jog-measuring §2.6.2): e.g. 105° for a 105° corner, not its supplement
+        u1 = _unit2(np.mean(q12, axis=0) - corner)
+        u2 = _unit2(np.mean(q34, axis=0) - corner)
+        values["corner_angle"] = float(np.degrees(np.arccos(np.clip(u1 @ u2, -1.0, 1.0))))
     fix = FeatureFix(position=_plane_point(plane, corner), angle=angle, angle_axis=plane.infeed,
                      reference_axis=plane.first, point=corner_xyz)
     return TaskResult(task, values, fix)
@@ -334,20 +361,16 @@ def _corner(task, params, points, plane, probe) -> TaskResult:
 
 # --- pockets, holes, spigots -------------------------------------------------------------
 
-def _kind_of(task: str) -> str:
-    return "spigot" if task.startswith("spigot") else "hole"
-
-
-def _rect(task, params, points, plane, probe) -> TaskResult:
-    """Rectangular pocket / spigot (jog §2.7.1, §2.8; measuring-math §8.3)."""
+def evaluate_rect(task: str, params: dict[str, Any], points: Sequence[StoredPoint], plane: Plane,
+        probe: ProbeRecord, *, kind: str) -> TaskResult:
+    """Rectangular pocket / spigot (jog-measuring §2.7.1, jog-measuring §2.8; measuring-math §8.3)."""
     if len(points) != 1:
         raise ValueError(f"{task} needs 1 stored point, got {len(points)}")
     (point,) = points
     if not isinstance(point, RectPoint):
         raise ValueError(f"{task}: expected a RectPoint, got {type(point).__name__}")
     if len(point.touches) == 4:
-        centre, length, width = rect_from_touches(point.touches, plane,
-                                                  "pocket" if task == "pocket.rect" else "spigot")
+        centre, length, width = rect_from_touches(point.touches, plane, kind)
     else:
         centre, length, width = np.asarray(point.center, float), point.length, point.width
     ao = _ao(plane, centre)
@@ -355,40 +378,41 @@ def _rect(task, params, points, plane, probe) -> TaskResult:
     return TaskResult(task, values, FeatureFix(position=_plane_point(plane, ao), point=centre))
 
 
-def _circle1(task, params, points, plane, probe) -> TaskResult:
-    """1 hole / 1 circular spigot (jog §2.7.1, §2.8): centre P0 and diameter."""
+def evaluate_circle1(task: str, params: dict[str, Any], points: Sequence[StoredPoint], plane: Plane,
+        probe: ProbeRecord, *, kind: str) -> TaskResult:
+    """1 hole / 1 circular spigot (jog-measuring §2.7.1, jog-measuring §2.8): centre P0 and diameter."""
     if len(points) != 1:
         raise ValueError(f"{task} needs 1 stored point, got {len(points)}")
-    centre, diameter = _circle_of(points[0], plane, _kind_of(task), probe)
+    centre, diameter = _circle_of(points[0], plane, kind, probe)
     ao = _ao(plane, centre)
     values = {"center": _plane_point(plane, ao), "diameter": diameter}
     return TaskResult(task, values, FeatureFix(position=_plane_point(plane, ao), point=centre))
 
 
-def _centres(task, points, n, plane, probe) -> tuple[list[np.ndarray], list[float], float]:
+def _centres(task: str, points: Sequence[StoredPoint], n: int, plane: Plane, probe: ProbeRecord, kind: str) -> tuple[list[FloatArray], list[float], float]:
     if len(points) != n:
         raise ValueError(f"{task} needs {n} stored points, got {len(points)}")
-    kind = _kind_of(task)
     circles = [_circle_of(p, plane, kind, probe) for p in points]
     centres = [_ao(plane, c) for c, _ in circles]
     height = float(np.mean([plane.to_aop(c)[2] for c, _ in circles]))
     return centres, [d for _, d in circles], height
 
 
-def _directed_angle(a, b, what: str) -> float:
+def _directed_angle(a: FloatArray, b: FloatArray, what: str) -> float:
     if np.linalg.norm(b - a) < _COINCIDENT_TOL:
-        raise MeasuringError(61367, f"{what}: the points are identical")
+        raise MeasuringError(alarms.POINTS_IDENTICAL, f"{what}: the points are identical")
     return _angle_ao(b - a)
 
 
-def _circles2(task, params, points, plane, probe) -> TaskResult:
-    """2 holes / spigots (jog §2.7.2): alpha of the line P1→P2 against the 1st plane axis.
+def evaluate_circles2(task: str, params: dict[str, Any], points: Sequence[StoredPoint], plane: Plane,
+        probe: ProbeRecord, *, kind: str) -> TaskResult:
+    """2 holes / spigots (jog-measuring §2.7.2): alpha of the line P1→P2 against the 1st plane axis.
 
     fix: the angle when an angle correction is asked (default "rotation"); with ``set_p1``
     and coordinate rotation also the translation of P1.
     """
-    (p1, p2), diameters, height = _centres(task, points, 2, plane, probe)
-    alpha = _directed_angle(p1, p2, "P1→P2")                                   # §2.7.2
+    (p1, p2), diameters, height = _centres(task, points, 2, plane, probe, kind)
+    alpha = _directed_angle(p1, p2, "P1→P2")                                   # jog-measuring §2.7.2
     values = {"angle": alpha, "p1": _plane_point(plane, p1), "p2": _plane_point(plane, p2),
               "distance": float(np.linalg.norm(p2 - p1)), "diameters": diameters}
     correction = params.get("angle_correction", "rotation")
@@ -400,29 +424,29 @@ def _circles2(task, params, points, plane, probe) -> TaskResult:
     return TaskResult(task, values, fix)
 
 
-def _circles34(task, params, points, plane, probe) -> TaskResult:
-    """3 / 4 holes or spigots (jog §2.7.3, §2.7.4).
+def evaluate_circles34(task: str, params: dict[str, Any], points: Sequence[StoredPoint], plane: Plane,
+        probe: ProbeRecord, *, kind: str, n: int) -> TaskResult:
+    """3 / 4 holes or spigots (jog-measuring §2.7.3, jog-measuring §2.7.4).
 
     3: P0 = circumcentre of P1..P3 (CYCLE116; collinear -> 61316), alpha of P0→P1.
     4: P0 = intersection of the diagonals P1P3 and P2P4 (parallel -> 61368), alpha of P1→P2.
     fix: translation of P0; the angle only when ``angle_correction`` is not "none" (default).
     """
-    n = 3 if task.endswith(".3") else 4
-    centres, diameters, height = _centres(task, points, n, plane, probe)
+    centres, diameters, height = _centres(task, points, n, plane, probe, kind)
     if n == 3:
-        circle = fit_circle(np.array(centres))                                 # §6 circumcircle
+        circle = fit_circle(np.array(centres))                                 # jog-measuring §6 circumcircle
         p0 = circle.center
         extra = {"pitch_diameter": 2.0 * circle.radius}
     else:
         for i, j in ((0, 2), (1, 3)):
             if np.linalg.norm(centres[j] - centres[i]) < _COINCIDENT_TOL:
-                raise MeasuringError(61367, f"P{i + 1} and P{j + 1} are identical")
+                raise MeasuringError(alarms.POINTS_IDENTICAL, f"P{i + 1} and P{j + 1} are identical")
         p0 = intersect_lines(fit_line(np.array([centres[0], centres[2]])),
                              fit_line(np.array([centres[1], centres[3]])))
         extra = {}
     pts = [p0, *centres]
     i, j = HOLE_ANGLE_LINE[n]
-    alpha = _directed_angle(pts[i], pts[j], f"P{i}→P{j}")                     # jog §11 Q6
+    alpha = _directed_angle(pts[i], pts[j], f"P{i}→P{j}")                     # jog-measuring §11 Q6
     values = {"center": _plane_point(plane, p0), "angle": alpha,
               "points": [_plane_point(plane, c) for c in centres], "diameters": diameters, **extra}
     p0_xyz = _xyz(plane, p0, height)
@@ -435,52 +459,22 @@ def _circles34(task, params, points, plane, probe) -> TaskResult:
 
 # --- orient plane ---------------------------------------------------------------------------
 
-def _plane_align(task, params, points, plane, probe) -> TaskResult:
-    """Orient plane (jog §2.9): normal of the plane through the 3 surface points.
+def evaluate_plane_align(task: str, params: dict[str, Any], points: Sequence[StoredPoint], plane: Plane,
+        probe: ProbeRecord) -> TaskResult:
+    """Orient plane (jog-measuring §2.9): normal of the plane through the 3 surface points.
 
     n̂ oriented to +infeed; with R = Rot_o(beta)·Rot_a(alpha), R·ê_p = n̂:
     alpha = asin(−n_o), beta = atan2(n_a, n_p) (G17: asin(−n_y), atan2(n_x, n_z)).
     Collinear points -> 61411.
     """
-    touches = _edge_points(task, points, 3)
+    touches = _edge_points(task, points, max(3, len(points)))      # n >= 3 points: least squares
     fit = fit_plane(np.array([t.surface for t in touches], dtype=float))
     normal = fit.normal if fit.normal @ plane.infeed_unit > 0.0 else -fit.normal
     if abs(normal @ plane.infeed_unit) < 1e-12:
-        raise MeasuringError(61411, "frame calculation impossible: plane parallel to the infeed")
-    alpha, beta = alpha_beta_from_normal(normal, plane)                          # §2.9
+        raise MeasuringError(alarms.FRAME_IMPOSSIBLE, "frame calculation impossible: plane parallel to the infeed")
+    alpha, beta = alpha_beta_from_normal(normal, plane)                          # jog-measuring §2.9
     values = {"alpha": alpha, "beta": beta,
               "normal": {a: float(v) for a, v in zip(_AXES, normal, strict=True)},
-              "points": _touch_values(plane, touches)}
+              "points": _touch_values(plane, touches),
+              "residuals": [float(v) for v in fit.residuals], "form_error": float(fit.form_error)}
     return TaskResult(task, values, FeatureFix(normal=normal, point=fit.point))
-
-
-_TASKS: dict[str, Callable[..., TaskResult]] = {
-    "edge.set": _edge_set,
-    "edge.align": _edge_align,
-    "edge.distance": _edge_distance,
-    "corner.right": _corner,
-    "corner.any": _corner,
-    "pocket.rect": _rect,
-    "spigot.rect": _rect,
-    "hole.1": _circle1,
-    "spigot.1": _circle1,
-    "hole.2": _circles2,
-    "spigot.2": _circles2,
-    "hole.3": _circles34,
-    "hole.4": _circles34,
-    "spigot.3": _circles34,
-    "spigot.4": _circles34,
-    "plane.align": _plane_align,
-}
-
-WORKPIECE_TASKS = tuple(_TASKS)
-
-
-def evaluate(task: str, params: dict, points: list[StoredPoint], plane: Plane,
-             probe: ProbeRecord) -> TaskResult:
-    """Evaluate the stored points of ``task`` (design.md §4 names) in the measuring WCS."""
-    try:
-        handler = _TASKS[task]
-    except KeyError:
-        raise ValueError(f"unknown task {task!r}; known: {', '.join(_TASKS)}") from None
-    return handler(task, dict(params or {}), list(points), plane, probe or ProbeRecord())

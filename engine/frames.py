@@ -7,17 +7,22 @@ A frame maps the coordinate system above it (child, nearer the WCS) to the one b
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+import functools
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
+
+from engine.types import FloatArray
 
 GEOMETRY_AXES = ("X", "Y", "Z")
 
 
-def _vec3(value, name: str) -> np.ndarray:
-    arr = np.asarray(value, dtype=float)
+def _vec3(value: npt.ArrayLike, name: str) -> FloatArray:
+    arr = np.array(value, dtype=float)          # a copy: the frame owns (and freezes) it
     if arr.shape != (3,):
         raise ValueError(f"{name} must have shape (3,), got {arr.shape}")
     if not np.all(np.isfinite(arr)):
@@ -25,22 +30,22 @@ def _vec3(value, name: str) -> np.ndarray:
     return arr
 
 
-def rot_x(deg: float) -> np.ndarray:
+def rot_x(deg: float) -> FloatArray:
     c, s = np.cos(np.radians(deg)), np.sin(np.radians(deg))
     return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
 
 
-def rot_y(deg: float) -> np.ndarray:
+def rot_y(deg: float) -> FloatArray:
     c, s = np.cos(np.radians(deg)), np.sin(np.radians(deg))
     return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
-def rot_z(deg: float) -> np.ndarray:
+def rot_z(deg: float) -> FloatArray:
     c, s = np.cos(np.radians(deg)), np.sin(np.radians(deg))
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
-def rot_axis(axis: str, deg: float) -> np.ndarray:
+def rot_axis(axis: str, deg: float) -> FloatArray:
     """Right-hand rotation about the geometry axis ``axis`` ("X", "Y", "Z") (measuring-math §0.1)."""
     try:
         return {"X": rot_x, "Y": rot_y, "Z": rot_z}[axis](deg)
@@ -48,13 +53,13 @@ def rot_axis(axis: str, deg: float) -> np.ndarray:
         raise ValueError(f"axis must be X, Y or Z, got {axis!r}") from None
 
 
-def matrix_from_rpy(rot_deg) -> np.ndarray:
+def matrix_from_rpy(rot_deg: npt.ArrayLike) -> FloatArray:
     """R = Rz(c)·Ry(b)·Rx(a) for rot_deg = (a about X, b about Y, c about Z) (design.md §3 RPY)."""
     a, b, c = _vec3(rot_deg, "rot_deg")
     return rot_z(c) @ rot_y(b) @ rot_x(a)
 
 
-def rpy_from_matrix(matrix) -> np.ndarray:
+def rpy_from_matrix(matrix: npt.ArrayLike) -> FloatArray:
     """(a, b, c) in degrees with R = Rz(c)·Ry(b)·Rx(a) (measuring-math §0.2 extraction)."""
     r = np.asarray(matrix, dtype=float)
     if r.shape != (3, 3):
@@ -68,25 +73,27 @@ def rpy_from_matrix(matrix) -> np.ndarray:
     else:
         a = np.arctan2(r[2, 1], r[2, 2])
         c = np.arctan2(r[1, 0], r[0, 0])
-    return np.degrees(np.array([a, b, c]))
+    rpy: FloatArray = np.degrees(np.array([a, b, c], dtype=float))
+    return rpy
 
 
 @dataclass(frozen=True, eq=False)
 class Frame:
     """One frame: coarse + fine translation, RPY rotation (deg), rotary-axis offsets (deg).
 
-    Scaling and mirroring are not modelled (alarm 61310 territory, spec §1.7).
+    Scaling and mirroring are not modelled (alarm 61310 territory, jog-measuring §1.7).
     """
 
-    coarse: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    fine: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    rot: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    coarse: FloatArray = field(default_factory=lambda: np.zeros(3))
+    fine: FloatArray = field(default_factory=lambda: np.zeros(3))
+    rot: FloatArray = field(default_factory=lambda: np.zeros(3))
     rotary: tuple[tuple[str, float], ...] = ()
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "coarse", _vec3(self.coarse, "coarse"))
-        object.__setattr__(self, "fine", _vec3(self.fine, "fine"))
-        object.__setattr__(self, "rot", _vec3(self.rot, "rot"))
+        for name in ("coarse", "fine", "rot"):
+            value = _vec3(getattr(self, name), name)
+            value.flags.writeable = False            # a value object (frames are shared, see _frame_of)
+            object.__setattr__(self, name, value)
         rotary = tuple(sorted((str(k), float(v)) for k, v in dict(self.rotary).items()))
         object.__setattr__(self, "rotary", rotary)
         # the matrix is needed on every point mapping: computed once (frozen), read-only
@@ -100,25 +107,27 @@ class Frame:
         return cls()
 
     @classmethod
-    def from_matrix(cls, rotation, translation, rotary: Mapping[str, float] | None = None) -> Frame:
+    def from_matrix(cls, rotation: npt.ArrayLike, translation: npt.ArrayLike,
+                    rotary: Mapping[str, float] | None = None) -> Frame:
         """Frame with coarse translation ``translation`` and rotation ``rotation`` (3x3)."""
         return cls(coarse=_vec3(translation, "translation"), rot=rpy_from_matrix(rotation),
                    rotary=tuple((rotary or {}).items()))
 
-    def replace(self, **changes) -> Frame:
-        values = {"coarse": self.coarse, "fine": self.fine, "rot": self.rot, "rotary": self.rotary}
+    def replace(self, **changes: Any) -> Frame:
+        values: dict[str, Any] = {"coarse": self.coarse, "fine": self.fine, "rot": self.rot, "rotary": self.rotary}
         values.update(changes)
         return Frame(**values)
 
     # --- values -------------------------------------------------------------------------
     @property
-    def translation(self) -> np.ndarray:
+    def translation(self) -> FloatArray:
         """Total translation T = coarse + fine."""
         return self.coarse + self.fine
 
     @property
-    def rotation(self) -> np.ndarray:
-        return self._rotation
+    def rotation(self) -> FloatArray:
+        rotation: FloatArray = self.__dict__["_rotation"]   # set in __post_init__, not a field
+        return rotation
 
     def rotary_offset(self, axis: str) -> float:
         return dict(self.rotary).get(axis, 0.0)
@@ -130,7 +139,7 @@ class Frame:
         return self.replace(rotary=tuple(rotary.items()))
 
     # --- comparison (numpy fields: the generated dataclass __eq__ would raise) ----------
-    def _key(self) -> tuple:
+    def _key(self) -> tuple[object, ...]:
         return (tuple(self.coarse), tuple(self.fine), tuple(self.rot), self.rotary)
 
     def __eq__(self, other: object) -> bool:
@@ -149,7 +158,7 @@ class Frame:
                     and np.allclose(self.rotation, other.rotation, rtol=0.0, atol=tol)
                     and all(abs(self.rotary_offset(k) - other.rotary_offset(k)) <= tol for k in keys))
 
-    def as_matrix(self) -> np.ndarray:
+    def as_matrix(self) -> FloatArray:
         """4x4 homogeneous child2parent matrix."""
         m = np.eye(4)
         m[:3, :3] = self.rotation
@@ -157,18 +166,18 @@ class Frame:
         return m
 
     # --- mapping points and directions --------------------------------------------------
-    def child2parent(self, p_in_child) -> np.ndarray:
+    def child2parent(self, p_in_child: npt.ArrayLike) -> FloatArray:
         p = np.asarray(p_in_child, dtype=float)
         return p @ self.rotation.T + self.translation
 
-    def parent2child(self, p_in_parent) -> np.ndarray:
+    def parent2child(self, p_in_parent: npt.ArrayLike) -> FloatArray:
         p = np.asarray(p_in_parent, dtype=float)
         return (p - self.translation) @ self.rotation
 
-    def dir_child2parent(self, d_in_child) -> np.ndarray:
+    def dir_child2parent(self, d_in_child: npt.ArrayLike) -> FloatArray:
         return np.asarray(d_in_child, dtype=float) @ self.rotation.T
 
-    def dir_parent2child(self, d_in_parent) -> np.ndarray:
+    def dir_parent2child(self, d_in_parent: npt.ArrayLike) -> FloatArray:
         return np.asarray(d_in_parent, dtype=float) @ self.rotation
 
     # --- algebra ------------------------------------------------------------------------
@@ -190,7 +199,7 @@ class Frame:
                                  {k: -v for k, v in self.rotary})
 
     # --- API representation -------------------------------------------------------------
-    def to_api(self) -> dict:
+    def to_api(self) -> dict[str, Any]:
         """``{"trans": {X,Y,Z,<rotary>}, "fine": {X,Y,Z}, "rot": {X,Y,Z}}`` (design.md §4)."""
         trans = {a: float(v) for a, v in zip(GEOMETRY_AXES, self.coarse, strict=True)}
         trans.update({k: float(v) for k, v in self.rotary})
@@ -201,15 +210,22 @@ class Frame:
         }
 
     @classmethod
-    def from_api(cls, data: Mapping) -> Frame:
+    def from_api(cls, data: Mapping[str, Any]) -> Frame:
         trans = dict(data.get("trans") or {})
         fine = dict(data.get("fine") or {})
         rot = dict(data.get("rot") or {})
-        coarse = [float(trans.pop(a, 0.0)) for a in GEOMETRY_AXES]
-        return cls(coarse=coarse,
-                   fine=[float(fine.get(a, 0.0)) for a in GEOMETRY_AXES],
-                   rot=[float(rot.get(a, 0.0)) for a in GEOMETRY_AXES],
-                   rotary=tuple((k, float(v)) for k, v in trans.items()))
+        coarse = tuple(float(trans.pop(a, 0.0)) for a in GEOMETRY_AXES)
+        return _frame_of(coarse, tuple(float(fine.get(a, 0.0)) for a in GEOMETRY_AXES),
+                         tuple(float(rot.get(a, 0.0)) for a in GEOMETRY_AXES),
+                         tuple(sorted((str(k), float(v)) for k, v in trans.items())))
+
+
+@functools.lru_cache(maxsize=512)
+def _frame_of(coarse: tuple[float, ...], fine: tuple[float, ...], rot: tuple[float, ...],
+              rotary: tuple[tuple[str, float], ...]) -> Frame:
+    # frames are immutable values: the same stored numbers give the same (shared) Frame; every
+    # measurement reads all stored frames, and building one validates and makes its matrix
+    return Frame(coarse=np.array(coarse), fine=np.array(fine), rot=np.array(rot), rotary=rotary)
 
 
 def compose_chain(frames_outside_in: Sequence[Frame]) -> Frame:
@@ -241,13 +257,13 @@ class FrameChain:
         """Composed once per chain value (the chain is immutable)."""
         return self.below_settable.compose(self.settable)
 
-    def p_in_bcs(self, p_in_wcs) -> np.ndarray:
+    def p_in_bcs(self, p_in_wcs: npt.ArrayLike) -> FloatArray:
         return self.wcs2bcs.child2parent(p_in_wcs)
 
-    def p_in_wcs(self, p_in_bcs) -> np.ndarray:
+    def p_in_wcs(self, p_in_bcs: npt.ArrayLike) -> FloatArray:
         return self.wcs2bcs.parent2child(p_in_bcs)
 
-    def dir_in_bcs(self, d_in_wcs) -> np.ndarray:
+    def dir_in_bcs(self, d_in_wcs: npt.ArrayLike) -> FloatArray:
         return self.wcs2bcs.dir_child2parent(d_in_wcs)
 
     def parent2bcs_of_basic(self, index: int) -> Frame:
@@ -256,8 +272,43 @@ class FrameChain:
             raise ValueError(f"basic frame {index} does not exist (have {len(self.basic)})")
         return compose_chain([self.setframe, *self.basic[:index]])
 
-    def replace(self, **changes) -> FrameChain:
-        values = {"setframe": self.setframe, "basic": self.basic, "settable": self.settable}
+    def replace(self, **changes: Any) -> FrameChain:
+        values: dict[str, Any] = {"setframe": self.setframe, "basic": self.basic, "settable": self.settable}
         values.update(changes)
         values["basic"] = tuple(values["basic"])
         return FrameChain(**values)
+
+
+# --- the named frames of design.md §3/§4 ---------------------------------------------------------
+
+G500 = "G500"                  # no settable frame active
+SETFRAME = "BASIC_REF"         # the system frame outside the basic frames
+
+
+def basic_frame_names(names: Iterable[str]) -> tuple[str, ...]:
+    """BASIC_0, BASIC_1, … in chain order (BASIC_REF is the SETFRAME, outside all of them)."""
+    return tuple(sorted((n for n in names if n.startswith("BASIC_") and n != SETFRAME),
+                        key=lambda n: int(n.split("_")[1])))
+
+
+def chain_of(frames: Mapping[str, Frame], active: str) -> FrameChain:
+    """WCS->BCS = BASIC_REF ∘ BASIC_0 ∘ BASIC_1 ∘ … ∘ ``active`` (identity under G500)."""
+    return FrameChain(setframe=frames.get(SETFRAME, Frame.identity()),
+                      basic=tuple(frames[n] for n in basic_frame_names(frames)),
+                      settable=Frame.identity() if active == G500 else frames[active])
+
+
+def is_basic(name: str) -> bool:
+    """A basic frame (BASIC_REF, BASIC_n): always part of the active chain, unlike a settable WO."""
+    return name.startswith("BASIC")
+
+
+def parent2bcs_of(frames: Mapping[str, Frame], target: str) -> Frame:
+    """Composition of the frames outside ``target`` (MCS side first), from ``frames`` as given."""
+    chain = chain_of(frames, G500)
+    names = basic_frame_names(frames)
+    if target in names:
+        return chain.parent2bcs_of_basic(names.index(target))
+    if is_basic(target):            # BASIC_REF, the SETFRAME: nothing outside it
+        return Frame.identity()
+    return chain.below_settable

@@ -1,6 +1,6 @@
 """Planning contracts and the common probing execution (spec/jog-measuring.md §2.4).
 
-``PlanContext``, ``TASK_POINTS``, ``ParamError``, the stored points of calibration and tool
+``PlanContext``, ``ParamError``, the stored points of calibration and tool
 tasks, and ``Motion``: the positioning/probing helper every point program uses. Re-exported
 by ``engine.plan`` (the public module).
 """
@@ -9,20 +9,38 @@ from __future__ import annotations
 
 from collections.abc import Generator, Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Literal, TypeGuard
 
 import numpy as np
+import numpy.typing as npt
 
+from engine import alarms
+from engine.frames import Frame
 from engine.planes import Plane
-from engine.types import Latch, MeasuringError, MoveStep, ProbeRecord, ProbeStep, SpindleStep, Step
+from engine.types import (
+    FloatArray,
+    Latch,
+    MeasuringError,
+    MoveStep,
+    ProbeRecord,
+    ProbeStep,
+    SpindleStep,
+    Step,
+)
 
-TWO_STAGE_RETRACT = 2.0   # mm back after the fast first touch (spec §2.4 step 3, §8.4 _SPEED[3])
+if TYPE_CHECKING:
+    from engine.types import HitLatch
+
+TWO_STAGE_RETRACT = 2.0   # mm back after the fast first touch (jog-measuring §2.4 step 3, jog-measuring §8.4 _SPEED[3])
 
 
 @dataclass(frozen=True)
 class PlanContext:
     plane: Plane
     probe: ProbeRecord
-    skew_wcs: np.ndarray            # from compensation.skew_in_wcs
+    skew_wcs: FloatArray            # from compensation.skew_in_wcs
+    spindle_angle: float = 0.0      # SPOS while probing (a probe's lobing map turns with it)
+    wcs2bcs: Frame | None = None    # measuring WCS -> BCS (the lobing map's directions are machine ones)
     measuring_feed: float = 300.0   # E_MESS_FM
     position_feed: float = 2000.0   # E_MESS_F (plane)
     position_feed_infeed: float = 2000.0  # E_MESS_FZ
@@ -31,7 +49,8 @@ class PlanContext:
     fast_feed: float | None = None  # _SPEED[3] when _JM_B[3]=1 (two-stage), else None
     rapid_return: bool = False      # _JM_B[2]
     spigot_safety: float = 5.0
-    # --- tool measuring (spec §7, §8.3 GUD7 E_MESS_MT_*; tool probe record _TP[n] §8.4) -----
+    ring_chords: bool = False       # ring calibration also along chords off the centre (design.md §9.8)
+    # --- tool measuring (jog-measuring §7, jog-measuring §8.3 GUD7 E_MESS_MT_*; tool probe record _TP[n] jog-measuring §8.4) -----
     tool_probe: dict[str, float] | None = None  # _TP[n,0..4] by travel key "X-","X+","Y-","Y+","Z-" (MCS, tool edge)
     tool_radius: float = 0.0        # active tool R (geometry + wear) as the NC knows it
     tool_length: float = 0.0        # active tool L1 the NC uses for the tip (informative)
@@ -53,17 +72,6 @@ class PlanContext:
     min_accuracy: float = 0.01      # E_MESS_MIN_D
 
 
-TASK_POINTS: dict[str, int] = {
-    "edge.set": 1, "edge.align": 2, "edge.distance": 2,
-    "corner.right": 3, "corner.any": 4,
-    "pocket.rect": 1, "hole.1": 1, "hole.2": 2, "hole.3": 3, "hole.4": 4,
-    "spigot.rect": 1, "spigot.1": 1, "spigot.2": 2, "spigot.3": 3, "spigot.4": 4,
-    "plane.align": 3,
-    "probe.length": 1, "probe.radius": 1,
-    "toolprobe.calibrate": 1, "tool.length": 1, "tool.diameter": 1,
-}
-
-
 class ParamError(ValueError):
     """An invalid task parameter; ``field`` names it, the message names the problem."""
 
@@ -77,14 +85,17 @@ class ParamError(ValueError):
 
 @dataclass(frozen=True)
 class RingPass:
-    """One 4-direction pass in the ring gauge (spec §5.3): raw recs (WCS, no skew, no triggers).
+    """One pass in the ring gauge (jog-measuring §5.3): raw recs (WCS, no skew, no triggers).
 
     ``rec``/``latched_mcs`` keyed by travel direction "X+", "X-", ... (+1st, −1st, +2nd, −2nd).
+    A pass of an n-direction calibration (engine.lobing) keys them by its own labels and gives
+    each label's unit travel direction (WCS) in ``directions``; axis keys need none.
     """
 
     spindle_angle: float
-    rec: dict[str, np.ndarray]
-    latched_mcs: dict[str, np.ndarray | None] = field(default_factory=dict)
+    rec: dict[str, FloatArray]
+    latched_mcs: dict[str, FloatArray | None] = field(default_factory=dict)
+    directions: dict[str, FloatArray] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -101,8 +112,8 @@ class ToolTouch:
     """One tool-probe touch: tool tip (MCS) at switching; ``key`` = travel direction "Z-", "X+"."""
 
     key: str
-    rec: np.ndarray
-    latched_mcs: np.ndarray | None = None
+    rec: FloatArray
+    latched_mcs: FloatArray | None = None
     feed: float = 0.0
 
 
@@ -110,7 +121,7 @@ class ToolTouch:
 class ToolProbePoint:
     """toolprobe.calibrate: touches in probing order (the final "Z-" at the found centre last).
 
-    ``tool_radius``/``tool_length``: the calibration tool's data used (spec §7.2 formulas).
+    ``tool_radius``/``tool_length``: the calibration tool's data used (jog-measuring §7.2 formulas).
     """
 
     mode: str
@@ -121,7 +132,7 @@ class ToolProbePoint:
 
 @dataclass(frozen=True)
 class ToolPoint:
-    """tool.length / tool.diameter: the final (finest) touch and how it was made (spec §7.3)."""
+    """tool.length / tool.diameter: the final (finest) touch and how it was made (jog-measuring §7.3)."""
 
     kind: str                      # "length" | "radius"
     touch: ToolTouch               # final touch (L1 = F_z − _TP[n,4]; R = F_a − _TP[n,0] ...)
@@ -136,27 +147,28 @@ class ToolPoint:
 
 # --- common probing execution -------------------------------------------------------------
 
-def hit(latch: Latch | None) -> bool:
+def hit(latch: Latch | None) -> TypeGuard[HitLatch]:
     return latch is not None and latch.triggered and latch.rec is not None
 
 
 class Motion:
-    """Tracks the NC reference position and builds steps (spec §2.4 steps 2, 3, 5, 6).
+    """Tracks the NC reference position and builds steps (jog-measuring §2.4 steps 2, 3, 5, 6).
 
     Targets are NC reference positions in ``coords`` (WCS: ball centre/tip as the NC knows it;
-    MCS: tool tip). ``ball_offset`` = true ball centre − NC reference (skew, §1.3 / math §5.2):
+    MCS: tool tip). ``ball_offset`` = true ball centre − NC reference (skew, jog-measuring §1.3 / measuring-math §5.2):
     ``to_ball`` commands the reference so that the *ball* reaches a point.
     """
 
-    def __init__(self, start, ctx: PlanContext, coords: str = "WCS", ball_offset=None):
+    def __init__(self, start: npt.ArrayLike, ctx: PlanContext, coords: str = "WCS",
+                 ball_offset: npt.ArrayLike | None = None) -> None:
         self.pos = np.asarray(start, dtype=float).copy()
         self.start = self.pos.copy()
         self.ctx = ctx
         self.coords = coords
         self.ball_offset = np.zeros(3) if ball_offset is None else np.asarray(ball_offset, float)
 
-    def feed_for(self, target: np.ndarray) -> float:
-        """E_MESS_FZ for pure infeed-axis moves, else E_MESS_F (spec §2.4 step 1)."""
+    def feed_for(self, target: FloatArray) -> float:
+        """E_MESS_FZ for pure infeed-axis moves, else E_MESS_F (jog-measuring §2.4 step 1)."""
         delta = target - self.pos
         p = self.ctx.plane.infeed_unit
         in_plane = delta - float(delta @ p) * p
@@ -164,28 +176,31 @@ class Motion:
             return self.ctx.position_feed_infeed
         return self.ctx.position_feed
 
-    def move(self, target, label: str = "", feed: float | None | str = "auto") -> list[Step]:
-        """Monitored intermediate positioning (61302 on a switch, spec §2.4 step 2)."""
-        target = np.asarray(target, dtype=float)
-        if np.allclose(target, self.pos, rtol=0.0, atol=1e-12):
-            return []
-        f = self.feed_for(target) if feed == "auto" else feed
-        self.pos = target.copy()
-        return [MoveStep(target=target.copy(), feed=f, monitored=True, coords=self.coords, label=label)]
+    def move(self, target: npt.ArrayLike, label: str = "", feed: float | None | Literal["auto"] = "auto"
+             ) -> list[Step]:
+        """Monitored intermediate positioning (61302 on a switch, jog-measuring §2.4 step 2).
 
-    def to_ball(self, ball_target, label: str = "") -> list[Step]:
+        ``feed``: a feed, None (rapid) or "auto" (``feed_for``)."""
+        to = np.asarray(target, dtype=float)
+        if np.allclose(to, self.pos, rtol=0.0, atol=1e-12):
+            return []
+        f = self.feed_for(to) if isinstance(feed, str) else feed      # str: "auto"
+        self.pos = to.copy()
+        return [MoveStep(target=to.copy(), feed=f, monitored=True, coords=self.coords, label=label)]
+
+    def to_ball(self, ball_target: npt.ArrayLike, label: str = "") -> list[Step]:
         return self.move(np.asarray(ball_target, float) - self.ball_offset, label)
 
-    def back(self, target, label: str = "return") -> list[Step]:
-        """Return move: rapid with _JM_B[2]=1, else positioning feed (spec §2.4 step 6)."""
-        target = np.asarray(target, dtype=float)
-        feed = None if self.ctx.rapid_return else "auto"
-        return self.move(target, label, feed)
+    def back(self, target: npt.ArrayLike, label: str = "return") -> list[Step]:
+        """Return move: rapid with _JM_B[2]=1, else positioning feed (jog-measuring §2.4 step 6)."""
+        to = np.asarray(target, dtype=float)
+        feed: Literal["auto"] | None = None if self.ctx.rapid_return else "auto"
+        return self.move(to, label, feed)
 
-    def probe(self, direction, distance: float, label: str, *, expected: float | None = None,
+    def probe(self, direction: npt.ArrayLike, distance: float, label: str, *, expected: float | None = None,
               feeds: Sequence[float] | None = None, fine_retract: float = TWO_STAGE_RETRACT
-              ) -> Generator[Step, Latch | None, Latch]:
-        """Probe from the current position; retries and multi-stage probing (spec §2.4 3–5).
+              ) -> Generator[Step, Latch | None, HitLatch]:
+        """Probe from the current position; retries and multi-stage probing (jog-measuring §2.4 3–5).
 
         ``feeds`` default: [_SPEED[3], E_MESS_FM] with _JM_B[3]=1, else [E_MESS_FM]. Every later
         stage retracts ``fine_retract`` against the travel from the latched position and probes
@@ -219,7 +234,7 @@ class Motion:
                 self.pos = np.asarray(latch.rec, dtype=float).copy()
             if latch is not None:
                 return latch
-        raise MeasuringError(61301, "Probe not switched")
+        raise MeasuringError(alarms.PROBE_NOT_SWITCHED, "Probe not switched")
 
 
 def spindle(angle: float | None = None, speed: float | None = None, label: str = "") -> SpindleStep:

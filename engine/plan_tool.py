@@ -1,21 +1,27 @@
-"""Point programs of tool-probe calibration and tool length/diameter (spec §7, math §14).
+"""Point programs of tool-probe calibration and tool length/diameter (jog-measuring §7, measuring-math §14).
 
 Coordinates: MCS, NC reference = tool tip (steps use coords="MCS"). Tool probe record
-``ctx.tool_probe`` = _TP[n,0..4] keyed by travel direction (tool edge at switching, spec §7.2).
+``ctx.tool_probe`` = _TP[n,0..4] keyed by travel direction (tool edge at switching, jog-measuring §7.2).
 """
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
 
+from engine import alarms
 from engine.plan_base import Motion, PlanContext, ToolPoint, ToolProbePoint, ToolTouch, spindle
 from engine.plan_workpiece import Program
 from engine.toolmeasure import probe_centre, spindle_speed_feeds
-from engine.types import MeasuringError
+from engine.types import FloatArray, MeasuringError
+
+if TYPE_CHECKING:
+    from engine.types import HitLatch
 
 
 def rotating_speed_feeds(radius: float, ctx: PlanContext) -> tuple[float, list[float]]:
-    """Speed and stage feeds of a rotating-spindle measurement (engine.toolmeasure, math §14.2)
+    """Speed and stage feeds of a rotating-spindle measurement (engine.toolmeasure, measuring-math §14.2)
     with the GUD7 values of ``ctx``."""
     sf = spindle_speed_feeds(radius, max_surface_speed=ctx.max_surface_speed,
                              max_speed=ctx.max_spindle_speed, accuracy=ctx.min_accuracy,
@@ -25,23 +31,23 @@ def rotating_speed_feeds(radius: float, ctx: PlanContext) -> tuple[float, list[f
 
 
 def stationary_feeds(ctx: PlanContext) -> list[float]:
-    """Spec §11 Q20: coarse at E_MESS_F_FAK1·E_MESS_MT_FM (≤ E_MESS_F), fine at E_MESS_MT_FM."""
+    """jog-measuring §11 Q20: coarse at E_MESS_F_FAK1·E_MESS_MT_FM (≤ E_MESS_F), fine at E_MESS_MT_FM."""
     return [min(ctx.position_feed, ctx.feed_factor1 * ctx.mt_feed), ctx.mt_feed]
 
 
 def axis_allowed(code: int, axis: str, sign: float) -> bool:
-    """E_MESS_MT_AX digit code (spec §8.3): units X, tens Y, hundreds Z; 1 −, 2 +, 3 both."""
+    """E_MESS_MT_AX digit code (jog-measuring §8.3): units X, tens Y, hundreds Z; 1 −, 2 +, 3 both."""
     digit = (int(code) // 10 ** "XYZ".index(axis)) % 10
     return digit == 3 or (digit == 1 and sign < 0) or (digit == 2 and sign > 0)
 
 
-def _with_height(point: np.ndarray, p: np.ndarray, height: float) -> np.ndarray:
+def _with_height(point: FloatArray, p: FloatArray, height: float) -> FloatArray:
     return point - float(point @ p) * p + height * p
 
 
 def _tp(ctx: PlanContext, key: str) -> float:
     if not ctx.tool_probe or key not in ctx.tool_probe:
-        raise MeasuringError(61341, f"Tool probe not calibrated ({key} missing): calibrate the tool probe")
+        raise MeasuringError(alarms.NOT_CALIBRATED_IN_PLANE, f"Tool probe not calibrated ({key} missing): calibrate the tool probe")
     return float(ctx.tool_probe[key])
 
 
@@ -50,13 +56,14 @@ def _probe_centre(ctx: PlanContext, axis: str, fallback: float) -> float:
     return probe_centre(ctx.tool_probe or {}).get(axis, fallback)
 
 
-def _touch(key: str, latch, feed: float) -> ToolTouch:
+def _touch(key: str, latch: HitLatch, feed: float) -> ToolTouch:
     return ToolTouch(key=key, rec=np.asarray(latch.rec, float).copy(), latched_mcs=latch.latched_mcs,
                      feed=float(feed))
 
 
-def toolprobe_program(params: dict, start: np.ndarray, ctx: PlanContext, label: str) -> Program:
-    """Tool probe calibration (spec §7.2 [I], math §14.5 automatic order): −p; then +a, −a, +o,
+def toolprobe_program(params: dict[str, Any], start: FloatArray, ctx: PlanContext, label: str
+                      ) -> Program[ToolProbePoint]:
+    """Tool probe calibration (jog-measuring §7.2 [I], measuring-math §14.5 automatic order): −p; then +a, −a, +o,
     −o (+a, −a again) at E_MESS_MT_DZ below the found upper edge, each from the side (out,
     down, probe in, back, up); −p again at the found centre. Stationary spindle, E_MESS_MT_FM,
     path E_MESS_MT_D. Directions excluded by E_MESS_MT_AX are skipped."""
@@ -70,9 +77,9 @@ def toolprobe_program(params: dict, start: np.ndarray, ctx: PlanContext, label: 
     yield from m.back(m.start)
     if params.get("mode") == "length_diameter":
         if ctx.tool_radius <= 0.0:
-            raise MeasuringError(61351, "Tool length or radius is 0 (calibration tool radius)")
+            raise MeasuringError(alarms.TOOL_SIZE_ZERO, "Tool length or radius is 0 (calibration tool radius)")
         if ctx.mt_diameter_radius <= 0.0:
-            raise MeasuringError(61230, "Tool probe diameter too small (E_MESS_MT_DR)")
+            raise MeasuringError(alarms.TOOL_PROBE_DIAMETER, "Tool probe diameter too small (E_MESS_MT_DR)")
         top, start_h = float(first.rec @ p), float(m.start @ p)
         low = top - ctx.mt_dz                           # tool lower edge DZ below the upper edge
         out_r = ctx.mt_diameter_radius / 2.0 + ctx.tool_radius   # expected tool-centre distance
@@ -82,8 +89,8 @@ def toolprobe_program(params: dict, start: np.ndarray, ctx: PlanContext, label: 
         # (normal incidence, as the hole's 2nd pass). The last touch of each key counts.
         for axis in (plane.first, plane.second, plane.first):
             u = plane.unit(axis)
-            recs = {}
-            for sign in (1.0, -1.0):                    # + direction first (math §14.5)
+            recs: dict[float, FloatArray] = {}
+            for sign in (1.0, -1.0):                    # + direction first (measuring-math §14.5)
                 if not axis_allowed(ctx.mt_axes, axis, sign):
                     continue
                 d, key = sign * u, f"{axis}{'+' if sign > 0 else '-'}"
@@ -106,16 +113,17 @@ def toolprobe_program(params: dict, start: np.ndarray, ctx: PlanContext, label: 
                           tool_radius=float(ctx.tool_radius), tool_length=float(ctx.tool_length))
 
 
-def tool_length_program(params: dict, start: np.ndarray, ctx: PlanContext, label: str) -> Program:
-    """Tool length (spec §7.3): stationary and centred if 2R ≤ E_MESS_MT_DL, else rotating with
-    the tool offset R − V along +1st (§11 Q12); stationary: displaced by V. Two-stage −p probing
+def tool_length_program(params: dict[str, Any], start: FloatArray, ctx: PlanContext, label: str
+                        ) -> Program[ToolPoint]:
+    """Tool length (jog-measuring §7.3): stationary and centred if 2R ≤ E_MESS_MT_DL, else rotating with
+    the tool offset R − V along +1st (jog-measuring §11 Q12); stationary: displaced by V. Two-stage −p probing
     from the start height (1st stage), fine stages from E_MESS_D_L above the first switch."""
     plane = ctx.plane
     m = Motion(start, ctx, coords="MCS")
     p, a = plane.infeed_unit, plane.unit(plane.first)
     o = plane.unit(plane.second)
     if ctx.mt_diameter_length <= 0.0:
-        raise MeasuringError(61230, "Tool probe diameter too small (E_MESS_MT_DL)")
+        raise MeasuringError(alarms.TOOL_PROBE_DIAMETER, "Tool probe diameter too small (E_MESS_MT_DL)")
     top = _tp(ctx, f"{plane.infeed}-")
     radius, v = float(ctx.tool_radius), float(params.get("offset_v", 0.0))
     rotating = 2.0 * radius > ctx.mt_diameter_length
@@ -123,7 +131,7 @@ def tool_length_program(params: dict, start: np.ndarray, ctx: PlanContext, label
     start_h = float(m.start @ p)
     above = start_h - top
     if above < 0.0:
-        raise MeasuringError(61332, "Change tool tip position: the tool is below the probe's upper edge")
+        raise MeasuringError(alarms.TOOL_TIP_POSITION, "Change tool tip position: the tool is below the probe's upper edge")
     centre = (_probe_centre(ctx, plane.first, float(m.start @ a)) * a
               + _probe_centre(ctx, plane.second, float(m.start @ o)) * o)
     yield from m.move(_with_height(centre + lateral * a, p, start_h), f"{label} over probe")
@@ -145,20 +153,21 @@ def tool_length_program(params: dict, start: np.ndarray, ctx: PlanContext, label
                      lateral_offset=float(lateral), tool_radius=radius, tool_length=float(ctx.tool_length))
 
 
-def tool_diameter_program(params: dict, start: np.ndarray, ctx: PlanContext, label: str) -> Program:
-    """Tool radius (spec §7.3): rotating spindle, approach along E_MESS_MT_DIR on the 1st axis,
-    tip E_MESS_MT_DZ below the probe's upper edge raised by V (§11 Q12), centred on the 2nd
+def tool_diameter_program(params: dict[str, Any], start: FloatArray, ctx: PlanContext, label: str
+                          ) -> Program[ToolPoint]:
+    """Tool radius (jog-measuring §7.3): rotating spindle, approach along E_MESS_MT_DIR on the 1st axis,
+    tip E_MESS_MT_DZ below the probe's upper edge raised by V (jog-measuring §11 Q12), centred on the 2nd
     axis; 1st stage from at least E_MESS_MT_D before the expected switch, fine stages E_MESS_D_R."""
     plane = ctx.plane
     m = Motion(start, ctx, coords="MCS")
     p, a, o = plane.infeed_unit, plane.unit(plane.first), plane.unit(plane.second)
     radius, v = float(ctx.tool_radius), float(params.get("offset_v", 0.0))
     if radius <= 0.0:
-        raise MeasuringError(61351, "Tool length or radius is 0 (enter the approximate radius)")
+        raise MeasuringError(alarms.TOOL_SIZE_ZERO, "Tool length or radius is 0 (enter the approximate radius)")
     if ctx.mt_diameter_radius <= 0.0:
-        raise MeasuringError(61230, "Tool probe diameter too small (E_MESS_MT_DR)")
+        raise MeasuringError(alarms.TOOL_PROBE_DIAMETER, "Tool probe diameter too small (E_MESS_MT_DR)")
     if ctx.mt_dz <= 0.0:
-        raise MeasuringError(61349, "Distance probe upper edge to measuring position is 0 (E_MESS_MT_DZ)")
+        raise MeasuringError(alarms.TOOL_PROBE_DZ_ZERO, "Distance probe upper edge to measuring position is 0 (E_MESS_MT_DZ)")
     sign = -1.0 if ctx.mt_dir < 0 else 1.0
     key = f"{plane.first}{'+' if sign > 0 else '-'}"
     d = sign * a

@@ -1,13 +1,14 @@
 """Point programs of the workpiece tasks and the workpiece-probe calibration.
 
-Edges, corners, orient plane, probe length (spec §2.5, §2.6, §2.9, §5.2): one touch from the
-start. Holes/pockets/spigots (spec §2.7, §2.8; measuring-math §8.2): ±1st axis, mid-point,
-±2nd axis; circles twice. Ring calibration (spec §5.3, measuring-math §7.3).
+Edges, corners, orient plane, probe length (jog-measuring §2.5, jog-measuring §2.6, jog-measuring §2.9, jog-measuring §5.2): one touch from the
+start. Holes/pockets/spigots (jog-measuring §2.7, jog-measuring §2.8; measuring-math §8.2): ±1st axis, mid-point,
+±2nd axis; circles twice. Ring calibration (jog-measuring §5.3, measuring-math §7.3).
 """
 
 from __future__ import annotations
 
-from collections.abc import Generator
+from collections.abc import Callable, Generator
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
@@ -15,9 +16,17 @@ from engine.compensation import effective_radius, make_touch, parallel_axis, tri
 from engine.evaluate import circle_from_touches, rect_from_touches
 from engine.plan_base import Motion, PlanContext, RingCalibrationPoint, RingPass, spindle
 from engine.planes import Plane
-from engine.types import CirclePoint, EdgePoint, Latch, RectPoint, Step, Touch
+from engine.types import CirclePoint, EdgePoint, FloatArray, Latch, RectPoint, Step, Touch
 
-Program = Generator[Step, Latch | None, object]
+if TYPE_CHECKING:
+    from engine.types import HitLatch
+
+_R = TypeVar("_R")
+Program = Generator[Step, Latch | None, _R]     # a probing program returning _R (a point, a latch)
+# one chord: (motion, centre, direction, expected reach or half size (None: unknown), label)
+Chord = Callable[[Motion, FloatArray, FloatArray, "float | None", str], Program["HitLatch"]]
+PointOf = Callable[["HitLatch", FloatArray], FloatArray]   # the point a chord's latch gives
+Latches4 = tuple["HitLatch", "HitLatch", "HitLatch", "HitLatch"]
 
 
 # --- directions ---------------------------------------------------------------------------
@@ -26,8 +35,8 @@ def sign_of(direction: str) -> float:
     return 1.0 if direction == "+" else -1.0
 
 
-def corner_direction(kind: str, position: int, n: int, plane: Plane) -> np.ndarray:
-    """Travel direction of corner point n (spec §2.6 [I] table, design.md §3).
+def corner_direction(kind: str, position: int, n: int, plane: Plane) -> FloatArray:
+    """Travel direction of corner point n (jog-measuring §2.6 [I] table, design.md §3).
 
     Positions 1..4 = front-left, front-right, back-right, back-left (counter-clockwise from the
     corner at min 1st/min 2nd axis). P1, P2 (edge ∥ 1st axis) are probed along the 2nd axis,
@@ -43,43 +52,33 @@ def corner_direction(kind: str, position: int, n: int, plane: Plane) -> np.ndarr
     return sign * plane.unit(axis)
 
 
-def edge_direction(task: str, params: dict, n: int, plane: Plane) -> np.ndarray:
-    """Travel direction of an edge-type point (spec §2.5, §2.6, §2.9, §5.2)."""
-    if task in ("edge.set", "edge.align"):
-        return sign_of(params["direction"]) * plane.unit(params["axis"])
-    if task == "edge.distance":
-        key = "direction" if n == 1 else "direction_p2"
-        return sign_of(params[key]) * plane.unit(params["axis"])
-    if task.startswith("corner."):
-        return corner_direction(params["kind"], int(params["position"]), n, plane)
-    return -plane.infeed_unit          # plane.align, probe.length: −infeed (spec §2.9, §5.2)
-
-
-def plane_directions(plane: Plane, angle_deg: float) -> tuple[np.ndarray, np.ndarray]:
-    """1st/2nd plane axis turned by the probing angle about the infeed axis (spec §2.3)."""
+def plane_directions(plane: Plane, angle_deg: float) -> tuple[FloatArray, FloatArray]:
+    """1st/2nd plane axis turned by the probing angle about the infeed axis (jog-measuring §2.3)."""
     c, s = np.cos(np.radians(angle_deg)), np.sin(np.radians(angle_deg))
     a, o = plane.unit(plane.first), plane.unit(plane.second)
     return c * a + s * o, -s * a + c * o
 
 
-def ball_offset(ctx: PlanContext) -> np.ndarray:
-    """True ball centre − NC reference: skew (§1.3), + r·p̂ when L1 refers to the tip (§5.2)."""
+def ball_offset(ctx: PlanContext) -> FloatArray:
+    """True ball centre − NC reference: skew (measuring-math §1.3), + r·p̂ when L1 refers to the tip (measuring-math §5.2)."""
     off = np.asarray(ctx.skew_wcs, dtype=float).copy()
     if ctx.probe.length_to_tip:
         off = off + (ctx.probe.ball_diameter / 2.0) * ctx.plane.infeed_unit
     return off
 
 
-def _key(d: np.ndarray) -> str:
-    j, sign = parallel_axis(d)
-    return trigger_key(j, sign)
+def _key(d: FloatArray) -> str:
+    axis = parallel_axis(d)
+    if axis is None:
+        raise ValueError(f"ring calibration directions are axis-parallel, got {d}")
+    return trigger_key(*axis)
 
 
 # --- edge-type points -----------------------------------------------------------------------
 
-def edge_program(d: np.ndarray, start: np.ndarray, ctx: PlanContext, label: str,
-                 raw: bool = False) -> Program:
-    """Probe from the start along d, return to the start (spec §2.4, §11 Q10: stroke 2·E_MESS_D_M).
+def edge_program(d: FloatArray, start: FloatArray, ctx: PlanContext, label: str,
+                 raw: bool = False) -> Program[EdgePoint]:
+    """Probe from the start along d, return to the start (jog-measuring §2.4, jog-measuring §11 Q10: stroke 2·E_MESS_D_M).
 
     ``raw`` (probe.length): no skew, so ``touch.ball_centre`` = rec (+ r·p̂ with L1 to the tip).
     """
@@ -87,19 +86,19 @@ def edge_program(d: np.ndarray, start: np.ndarray, ctx: PlanContext, label: str,
     latch = yield from m.probe(d, 2.0 * ctx.measuring_path, label, expected=ctx.measuring_path)
     yield from m.back(m.start)
     skew = np.zeros(3) if raw else ctx.skew_wcs
-    return EdgePoint(make_touch(latch.rec, d, ctx.probe, ctx.plane, skew_wcs=skew,
+    return EdgePoint(make_touch(latch.rec, d, ctx.probe, ctx.plane, skew_wcs=skew, spindle_angle=ctx.spindle_angle, wcs2bcs=ctx.wcs2bcs,
                                 latched_mcs=latch.latched_mcs))
 
 
 # --- inner features: hole, rectangular pocket, ring gauge -------------------------------------
 
-def _inner_chord(m: Motion, centre: np.ndarray, d: np.ndarray, reach: float | None,
-                 label: str) -> Program:
+def _inner_chord(m: Motion, centre: FloatArray, d: FloatArray, reach: float | None,
+                 label: str) -> Program[HitLatch]:
     """One inner touch from the (ball) centre along d.
 
     ``reach`` = expected ball travel centre → switching (approx/2 − ρ). The stroke starts
-    E_MESS_D_M before it but not beyond the centre and ends E_MESS_D_M after it (spec §11 Q10);
-    without an approximate size: from the centre over 2·E_MESS_D_M (spec §2.3).
+    E_MESS_D_M before it but not beyond the centre and ends E_MESS_D_M after it (jog-measuring §11 Q10);
+    without an approximate size: from the centre over 2·E_MESS_D_M (jog-measuring §2.3).
     """
     path = m.ctx.measuring_path
     if reach is None:
@@ -113,13 +112,14 @@ def _inner_chord(m: Motion, centre: np.ndarray, d: np.ndarray, reach: float | No
     return latch
 
 
-def _pass(m: Motion, centre: np.ndarray, u1: np.ndarray, u2: np.ndarray, chord, sizes,
-          label: str, point_of) -> Program:
+def _pass(m: Motion, centre: FloatArray, u1: FloatArray, u2: FloatArray, chord: Chord,
+          sizes: tuple[float | None, float | None], label: str, point_of: PointOf
+          ) -> Program[tuple[Latches4, FloatArray]]:
     """+u1, −u1, to the found u1-centre, +u2, −u2 (measuring-math §8.2, '+ direction first').
 
     ``point_of(latch, d)``: the point whose chord mid-points give the centre — the compensated
     surface estimate (symmetric for any chord offset, even with per-direction pre-travel), or
-    the raw rec for calibration (math §7.3). Returns the 4 latches and the found centre.
+    the raw rec for calibration (measuring-math §7.3). Returns the 4 latches and the found centre.
     """
     l1 = yield from chord(m, centre, u1, sizes[0], f"{label} +1st")
     l2 = yield from chord(m, centre, -u1, sizes[0], f"{label} -1st")
@@ -132,27 +132,30 @@ def _pass(m: Motion, centre: np.ndarray, u1: np.ndarray, u2: np.ndarray, chord, 
     return (l1, l2, l3, l4), found
 
 
-def _surface_of(ctx: PlanContext):
-    def point_of(latch: Latch, d: np.ndarray) -> np.ndarray:
-        return make_touch(latch.rec, d, ctx.probe, ctx.plane, skew_wcs=ctx.skew_wcs).surface
+def _surface_of(ctx: PlanContext) -> PointOf:
+    def point_of(latch: HitLatch, d: FloatArray) -> FloatArray:
+        return make_touch(latch.rec, d, ctx.probe, ctx.plane, skew_wcs=ctx.skew_wcs, spindle_angle=ctx.spindle_angle, wcs2bcs=ctx.wcs2bcs).surface
     return point_of
 
 
-def _raw_rec(latch: Latch, d: np.ndarray) -> np.ndarray:
+def _raw_rec(latch: HitLatch, d: FloatArray) -> FloatArray:
     return np.asarray(latch.rec, dtype=float)
 
 
 # --- outer features: spigot, rectangular spigot -------------------------------------------------
 
-def _outer_chord_factory(dz: float):
-    def chord(m: Motion, centre: np.ndarray, d: np.ndarray, half: float, label: str) -> Program:
-        """Spigot path (spec §2.8 [I]): out to half + ρ + safety at start height, down DZ, probe
+def _outer_chord_factory(dz: float) -> Chord:
+    def chord(m: Motion, centre: FloatArray, d: FloatArray, size: float | None, label: str) -> Program[HitLatch]:
+        """Spigot path (jog-measuring §2.8 [I]): out to half + ρ + safety at start height, down DZ, probe
         inward, back by the safety distance, up DZ. Stroke: safety + min(E_MESS_D_M, half + ρ)
-        (ends at most at the centre, spec §11 Q10)."""
+        (ends at most at the centre, jog-measuring §11 Q10)."""
         ctx = m.ctx
         p = ctx.plane.infeed_unit
         rho = effective_radius(ctx.probe)
         safety = ctx.spigot_safety
+        if size is None:
+            raise ValueError("an outer chord needs the spigot's size")
+        half = size
         yield from m.to_ball(centre - (half + rho + safety) * d, f"{label} outward")
         yield from m.move(m.pos - dz * p, f"{label} down DZ")
         latch = yield from m.probe(d, safety + min(ctx.measuring_path, half + rho), label,
@@ -165,8 +168,8 @@ def _outer_chord_factory(dz: float):
 
 # --- evaluation of the stored point -------------------------------------------------------------
 
-def _touches(latches, dirs, ctx: PlanContext) -> tuple[Touch, ...]:
-    return tuple(make_touch(lt.rec, d, ctx.probe, ctx.plane, skew_wcs=ctx.skew_wcs,
+def _touches(latches: Latches4, dirs: tuple[FloatArray, ...], ctx: PlanContext) -> tuple[Touch, ...]:
+    return tuple(make_touch(lt.rec, d, ctx.probe, ctx.plane, skew_wcs=ctx.skew_wcs, spindle_angle=ctx.spindle_angle, wcs2bcs=ctx.wcs2bcs,
                             latched_mcs=lt.latched_mcs) for lt, d in zip(latches, dirs, strict=True))
 
 
@@ -178,15 +181,15 @@ def circle_point(touches: tuple[Touch, ...], ctx: PlanContext, inner: bool) -> C
 
 
 def rect_point(touches: tuple[Touch, ...], ctx: PlanContext, inner: bool) -> RectPoint:
-    """L, W, centre from ±1st, ±2nd touches (engine.evaluate.rect_from_touches, math §8.3)."""
+    """L, W, centre from ±1st, ±2nd touches (engine.evaluate.rect_from_touches, measuring-math §8.3)."""
     centre, length, width = rect_from_touches(touches, ctx.plane, "pocket" if inner else "spigot")
     return RectPoint(center=centre, length=length, width=width, touches=touches)
 
 
 # --- programs -----------------------------------------------------------------------------------
 
-def _circle_program(params: dict, start: np.ndarray, ctx: PlanContext, label: str, chord, half,
-                    inner: bool) -> Program:
+def _circle_program(params: dict[str, Any], start: FloatArray, ctx: PlanContext, label: str, chord: Chord,
+                    half: float | None, inner: bool) -> Program[CirclePoint]:
     """Pass 1 finds the centre, pass 2 from the found centre makes every travel line a
     diameter, so each touch hits the wall at normal incidence — where the calibrated
     per-direction trigger values hold — and both chords are diameters."""
@@ -200,50 +203,68 @@ def _circle_program(params: dict, start: np.ndarray, ctx: PlanContext, label: st
     return circle_point(_touches(latches, (u1, -u1, u2, -u2), ctx), ctx, inner)
 
 
-def hole_program(params: dict, start: np.ndarray, ctx: PlanContext, label: str) -> Program:
-    """Hole at measuring depth (spec §2.7.1), inner chords from the centre."""
+def hole_program(params: dict[str, Any], start: FloatArray, ctx: PlanContext, label: str) -> Program[CirclePoint]:
+    """Hole at measuring depth (jog-measuring §2.7.1), inner chords from the centre."""
     diameter = params.get("diameter")
     reach = None if not diameter else diameter / 2.0 - effective_radius(ctx.probe)
     return (yield from _circle_program(params, start, ctx, label, _inner_chord, reach, inner=True))
 
 
-def spigot_program(params: dict, start: np.ndarray, ctx: PlanContext, label: str) -> Program:
-    """Circular spigot from above (spec §2.8): outer path per direction (down DZ, probe inward)."""
+def spigot_program(params: dict[str, Any], start: FloatArray, ctx: PlanContext, label: str
+                   ) -> Program[CirclePoint]:
+    """Circular spigot from above (jog-measuring §2.8): outer path per direction (down DZ, probe inward)."""
     chord = _outer_chord_factory(float(params["infeed"]))
     return (yield from _circle_program(params, start, ctx, label, chord, params["diameter"] / 2.0,
                                        inner=False))
 
 
-def rect_program(params: dict, start: np.ndarray, ctx: PlanContext, label: str, inner: bool) -> Program:
-    """Rectangular pocket (at depth) / spigot (from above, DZ): ±1st, mid, ±2nd (spec §2.7.1, §2.8)."""
+def rect_program(params: dict[str, Any], start: FloatArray, ctx: PlanContext, label: str, inner: bool
+                 ) -> Program[RectPoint]:
+    """Rectangular pocket (at depth) / spigot (from above, DZ): ±1st, mid, ±2nd (jog-measuring §2.7.1, jog-measuring §2.8)."""
     m = Motion(start, ctx, ball_offset=ball_offset(ctx))
     a, o = plane_directions(ctx.plane, 0.0)
     length, width = params.get("length"), params.get("width")
+    sizes: tuple[float | None, float | None]
+    chord: Chord
     if inner:
         rho = effective_radius(ctx.probe)
         sizes = (None if not length else length / 2.0 - rho, None if not width else width / 2.0 - rho)
         chord = _inner_chord
     else:
-        sizes, chord = (length / 2.0, width / 2.0), _outer_chord_factory(float(params["infeed"]))
+        sizes, chord = (params["length"] / 2.0, params["width"] / 2.0), _outer_chord_factory(float(params["infeed"]))
     latches, _ = yield from _pass(m, m.start + m.ball_offset, a, o, chord, sizes, label, _surface_of(ctx))
     yield from m.back(m.start)
     return rect_point(_touches(latches, (a, -a, o, -o), ctx), ctx, inner)
 
 
-def ring_program(params: dict, start: np.ndarray, ctx: PlanContext, label: str) -> Program:
-    """Probe radius calibration in a ring of known D, unknown centre (spec §5.3, math §7.3).
+def ring_program(params: dict[str, Any], start: FloatArray, ctx: PlanContext, label: str
+                 ) -> Program[RingCalibrationPoint]:
+    """Probe radius calibration in a ring of known D, unknown centre (jog-measuring §5.3, measuring-math §7.3).
 
     SPOS 0°, find the centre (±1st, mid, ±2nd, mid); pass 1 at SPOS 180°, pass 2 at SPOS 0°,
     both from the found centre; end at the pass-2 centre (ball on the ring centre at 0°).
     Raw recs only: positioning uses no skew and the nominal radius, never old trigger values.
+
+    ``params["directions"]`` = n ≠ 4 or ``params["chord_offset"]`` = h > 0 (both optional;
+    engine.lobing map, engine.calibration first_harmonic="estimate"): after the same centre search
+    each pass probes n directions 360°/n apart (from +1st, counter-clockwise) from the found
+    centre — with h > 0 twice, along chords h to either side of it (oblique incidence); the passes
+    key their recs "0", "30", ... (with h: "0/+", "0/-", ...) with the unit directions in
+    RingPass.directions; the probe ends at the found centre. Default: the program above.
     """
+    n_dirs = int(params.get("directions", 4) or 4)
+    chord_offset = float(params.get("chord_offset", 0.0) or 0.0)
+    if not chord_offset and ctx.ring_chords:     # chords halfway out (docs/noise-bound.md: h = (R − r)/2)
+        chord_offset = 0.5 * (params["diameter"] / 2.0 - ctx.probe.ball_diameter / 2.0)
+    if n_dirs != 4 or chord_offset:
+        return (yield from _ring_program_n(params, start, ctx, label, n_dirs, chord_offset))
     m = Motion(start, ctx)                      # ball_offset 0: calibration must not use old data
     a, o = plane_directions(ctx.plane, 0.0)
     dirs = (a, -a, o, -o)
     reach = params["diameter"] / 2.0 - ctx.probe.ball_diameter / 2.0
     yield spindle(angle=0.0, label=f"{label} SPOS 0")
 
-    def as_pass(angle: float, latches) -> RingPass:
+    def as_pass(angle: float, latches: Latches4) -> RingPass:
         return RingPass(angle, {_key(d): np.asarray(lt.rec, float).copy() for d, lt in zip(dirs, latches, strict=True)},
                         {_key(d): lt.latched_mcs for d, lt in zip(dirs, latches, strict=True)})
 
@@ -258,4 +279,46 @@ def ring_program(params: dict, start: np.ndarray, ctx: PlanContext, label: str) 
                                           f"{label} SPOS {angle:g}", _raw_rec)
         passes.append(as_pass(angle, latches))
     yield from m.move(found, f"{label} to centre")
+    return RingCalibrationPoint(diameter=float(params["diameter"]), search=search, passes=tuple(passes))
+
+
+def _ring_program_n(params: dict[str, Any], start: FloatArray, ctx: PlanContext, label: str, n_dirs: int,
+                    chord_offset: float = 0.0) -> Program[RingCalibrationPoint]:
+    """n-direction ring calibration (ring_program, ``params["directions"]``, ``["chord_offset"]``)."""
+    if n_dirs < 4:
+        raise ValueError(f"a ring calibration needs 4 or more directions, got {n_dirs}")
+    reach_max = params["diameter"] / 2.0 - ctx.probe.ball_diameter / 2.0
+    if not 0.0 <= chord_offset < 0.9 * reach_max:
+        raise ValueError(f"chord_offset must lie in [0, {0.9 * reach_max:g}) mm, got {chord_offset:g}")
+    m = Motion(start, ctx)
+    a, o = plane_directions(ctx.plane, 0.0)
+    axis_dirs = (a, -a, o, -o)
+    reach = params["diameter"] / 2.0 - ctx.probe.ball_diameter / 2.0
+    yield spindle(angle=0.0, label=f"{label} SPOS 0")
+    latches, centre = yield from _pass(m, m.start, a, o, _inner_chord, (reach, reach), f"{label} centre",
+                                       _raw_rec)
+    search = RingPass(0.0, {_key(d): np.asarray(lt.rec, float).copy() for d, lt in zip(axis_dirs, latches, strict=True)},
+                      {_key(d): lt.latched_mcs for d, lt in zip(axis_dirs, latches, strict=True)})
+    yield from m.move(centre, f"{label} to centre")
+    steps = [360.0 * k / n_dirs for k in range(n_dirs)]
+    passes = []
+    for angle in (180.0, 0.0):
+        yield spindle(angle=angle, label=f"{label} SPOS {angle:g}")
+        recs: dict[str, FloatArray] = {}
+        raw: dict[str, FloatArray | None] = {}
+        dirs: dict[str, FloatArray] = {}
+        for theta in steps:
+            d, d_perp = plane_directions(ctx.plane, theta)
+            for side in ((0.0,) if not chord_offset else (1.0, -1.0)):
+                key = f"{theta:g}" if not chord_offset else f"{theta:g}/{'+' if side > 0 else '-'}"
+                origin = centre + side * chord_offset * d_perp
+                chord = float(np.sqrt(reach * reach - chord_offset * chord_offset))
+                if side:
+                    yield from m.move(origin, f"{label} chord {key}")
+                latch = yield from _inner_chord(m, origin, d, chord, f"{label} SPOS {angle:g} {key}°")
+                recs[key], raw[key], dirs[key] = np.asarray(latch.rec, dtype=float).copy(), latch.latched_mcs, d.copy()
+                yield from m.move(origin, f"{label} back")
+                if side:
+                    yield from m.move(centre, f"{label} to centre")
+        passes.append(RingPass(angle, recs, raw, dirs))
     return RingCalibrationPoint(diameter=float(params["diameter"]), search=search, passes=tuple(passes))

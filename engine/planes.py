@@ -8,6 +8,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
+
+from engine.types import FloatArray
 
 _AXIS_INDEX = {"X": 0, "Y": 1, "Z": 2}
 
@@ -34,26 +37,26 @@ class Plane:
         return tuple(_AXIS_INDEX[a] for a in self.axes)  # type: ignore[return-value]
 
     @property
-    def aop2xyz(self) -> np.ndarray:
+    def aop2xyz(self) -> FloatArray:
         """3x3 matrix whose columns are the unit vectors of a, o, p in XYZ: p_xyz = M @ p_aop."""
         m = np.zeros((3, 3))
         for col, idx in enumerate(self.index):
             m[idx, col] = 1.0
         return m
 
-    def to_aop(self, p_xyz) -> np.ndarray:
+    def to_aop(self, p_xyz: npt.ArrayLike) -> FloatArray:
         return np.asarray(p_xyz, dtype=float) @ self.aop2xyz
 
-    def to_xyz(self, p_aop) -> np.ndarray:
+    def to_xyz(self, p_aop: npt.ArrayLike) -> FloatArray:
         return np.asarray(p_aop, dtype=float) @ self.aop2xyz.T
 
-    def unit(self, axis: str) -> np.ndarray:
+    def unit(self, axis: str) -> FloatArray:
         e = np.zeros(3)
         e[_AXIS_INDEX[axis]] = 1.0
         return e
 
     @property
-    def infeed_unit(self) -> np.ndarray:
+    def infeed_unit(self) -> FloatArray:
         """Unit vector of the applicate (tool axis, pointing from tip to spindle)."""
         return self.unit(self.infeed)
 

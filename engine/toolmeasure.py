@@ -1,11 +1,11 @@
 """Tool measuring math: tool-probe calibration, length, radius, offsets, spindle speed/feed.
 
-Spec: measuring-math §14 (CYCLE971), spec/jog-measuring.md §7.2, §7.3, §11 Q12/Q13.
+Spec: measuring-math §14 (CYCLE971), spec/jog-measuring.md §7.2, jog-measuring §7.3, jog-measuring §11 Q12/Q13.
 
 Tool probe record ``_TP[n]`` is a dict keyed by the travel direction of the touch (MCS axis
 letter + sign, as engine.plan_base.PlanContext.tool_probe): "X-" = _TP[n,0] (travel −X, the
 probe's +X face), "X+" = _TP[n,1], "Y-" = [2], "Y+" = [3], "Z-" = [4]: the coordinate of the
-tool edge at switching (spec §7.2 table). ``F`` = tool reference point (spindle nose) at the
+tool edge at switching (jog-measuring §7.2 table). ``F`` = tool reference point (spindle nose) at the
 latch; the tool tip is ``F − L1·p̂`` (design.md §4). Radius measuring uses the tool centre
 line ``X_c`` (= F in the plane).
 """
@@ -15,9 +15,12 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
+from engine import alarms
 from engine.plan_base import ToolPoint, ToolProbePoint
 from engine.planes import Plane, axis_index
 from engine.types import MeasuringError
@@ -29,11 +32,11 @@ __all__ = [
 ]
 
 
-# --- tool probe calibration (math §14.5, spec §7.2) -----------------------------------------
+# --- tool probe calibration (measuring-math §14.5, jog-measuring §7.2) -----------------------------------------
 
 def calibrate_tool_probe(switch: dict[str, float], cal_length: float, cal_radius: float, plane: Plane,
-                         old: dict[str, float] | None = None) -> tuple[dict[str, float], dict]:
-    """_TP values from the calibration tool's exact L_c, R_c (math §14.5 [M], spec §7.2).
+                         old: dict[str, float] | None = None) -> tuple[dict[str, float], dict[str, Any]]:
+    """_TP values from the calibration tool's exact L_c, R_c (measuring-math §14.5 [M], jog-measuring §7.2).
 
     ``switch[key]``: the reference coordinate on the key's axis at the latch — for the −infeed
     key ("Z-" in G17) the spindle nose F_p, for plane keys the tool centre line X_c / Y_c (MCS):
@@ -51,14 +54,14 @@ def calibrate_tool_probe(switch: dict[str, float], cal_length: float, cal_radius
             raise ValueError(f"bad tool probe key {key!r}")
         if key == p_key:
             if cal_length <= 0.0:
-                raise MeasuringError(61351, "Tool length or radius is 0 (calibration tool length)")
-            measured[key] = float(value) - cal_length                       # §14.5 F_z − L_c
+                raise MeasuringError(alarms.TOOL_SIZE_ZERO, "Tool length or radius is 0 (calibration tool length)")
+            measured[key] = float(value) - cal_length                       # measuring-math §14.5 F_z − L_c
         elif key[0] == plane.infeed:
             raise ValueError(f"the tool axis is only probed in minus direction, got {key!r}")
         else:
             if cal_radius <= 0.0:
-                raise MeasuringError(61351, "Tool length or radius is 0 (calibration tool radius)")
-            # §14.5: travel −X: X_c − R_c; travel +X: X_c + R_c
+                raise MeasuringError(alarms.TOOL_SIZE_ZERO, "Tool length or radius is 0 (calibration tool radius)")
+            # measuring-math §14.5: travel −X: X_c − R_c; travel +X: X_c + R_c
             measured[key] = float(value) - cal_radius if key[1] == "-" else float(value) + cal_radius
     record.update(measured)
     values = {"tool_probe": dict(record),
@@ -69,10 +72,10 @@ def calibrate_tool_probe(switch: dict[str, float], cal_length: float, cal_radius
 
 
 def calibrate_tool_probe_point(point: ToolProbePoint, plane: Plane, old: dict[str, float] | None = None
-                               ) -> tuple[dict[str, float], dict]:
+                               ) -> tuple[dict[str, float], dict[str, Any]]:
     """``calibrate_tool_probe`` from engine.plan's stored point (touch ``rec`` = tool tip, MCS).
 
-    The −p value uses the last −p touch (at the found centre, §14.5 automatic order); F_p =
+    The −p value uses the last −p touch (at the found centre, measuring-math §14.5 automatic order); F_p =
     tip_p + L1 with L1 = ``point.tool_length`` (the calibration tool's exact length is active).
     """
     p_key = f"{plane.infeed}-"
@@ -85,7 +88,7 @@ def calibrate_tool_probe_point(point: ToolProbePoint, plane: Plane, old: dict[st
 
 
 def probe_centre(record: dict[str, float]) -> dict[str, float]:
-    """Probe centre per plane axis with both directions known: (_TP[a−] + _TP[a+])/2 (§14.5)."""
+    """Probe centre per plane axis with both directions known: (_TP[a−] + _TP[a+])/2 (measuring-math §14.5)."""
     out = {}
     for axis in "XYZ":
         if f"{axis}-" in record and f"{axis}+" in record:
@@ -93,21 +96,21 @@ def probe_centre(record: dict[str, float]) -> dict[str, float]:
     return out
 
 
-# --- measuring (math §14.4, spec §7.3 [I]) ------------------------------------------------
+# --- measuring (measuring-math §14.4, jog-measuring §7.3 [I]) ------------------------------------------------
 
 def tool_length(f_infeed: float, record: dict[str, float], plane: Plane) -> float:
-    """L1 = F_p − _TP[n,4] (math §14.4; spec §7.3). Offset V and the rotating-spindle lateral
-    offset (R − V, spec §11 Q12) only move the contact in the plane: the formula is the same."""
+    """L1 = F_p − _TP[n,4] (measuring-math §14.4; jog-measuring §7.3). Offset V and the rotating-spindle lateral
+    offset (R − V, jog-measuring §11 Q12) only move the contact in the plane: the formula is the same."""
     key = f"{plane.infeed}-"
     if key not in record:
-        raise MeasuringError(61341, f"Tool probe not calibrated ({key})")
+        raise MeasuringError(alarms.NOT_CALIBRATED_IN_PLANE, f"Tool probe not calibrated ({key})")
     return float(f_infeed) - float(record[key])
 
 
 def tool_radius(centre_a: float, key: str, record: dict[str, float]) -> float:
-    """R from the side touch (math §14.4): travel −a: R = X_c − _TP[a−]; +a: R = _TP[a+] − X_c."""
+    """R from the side touch (measuring-math §14.4): travel −a: R = X_c − _TP[a−]; +a: R = _TP[a+] − X_c."""
     if key not in record:
-        raise MeasuringError(61341, f"Tool probe not calibrated ({key})")
+        raise MeasuringError(alarms.NOT_CALIBRATED_IN_PLANE, f"Tool probe not calibrated ({key})")
     if key.endswith("-"):
         return float(centre_a) - float(record[key])
     return float(record[key]) - float(centre_a)
@@ -119,17 +122,17 @@ def tool_point_value(point: ToolPoint, record: dict[str, float], plane: Plane) -
     rec = np.asarray(point.touch.rec, dtype=float)
     if point.kind == "length":
         if point.tool_length <= 0.0:
-            raise MeasuringError(61351, "Tool length or radius is 0")
+            raise MeasuringError(alarms.TOOL_SIZE_ZERO, "Tool length or radius is 0")
         f_p = float(rec[axis_index(plane.infeed)]) + point.tool_length    # F = tip + L1
         return tool_length(f_p, record, plane)
     if point.tool_radius <= 0.0:
-        raise MeasuringError(61351, "Tool length or radius is 0")
+        raise MeasuringError(alarms.TOOL_SIZE_ZERO, "Tool length or radius is 0")
     return tool_radius(float(rec[axis_index(point.touch.key[0])]), point.touch.key, record)
 
 
 def tool_offset_update(measured: float, geometry: float, wear: float, mode: str,
-                       zero_limit: float = 0.0) -> dict:
-    """Offset bookkeeping (spec §7.3 _JM_B[0], §11 Q13; math §14.4 _CHBIT[3]).
+                       zero_limit: float = 0.0) -> dict[str, Any]:
+    """Offset bookkeeping (jog-measuring §7.3 _JM_B[0], jog-measuring §11 Q13; measuring-math §14.4 _CHBIT[3]).
 
     Δ = measured − (geometry + wear). |Δ| < ``zero_limit`` (_TZL, 0 in JOG): unchanged.
     ``mode`` "geometry" (_JM_B[0]=0): geometry := measured, wear := 0.
@@ -149,7 +152,7 @@ def tool_offset_update(measured: float, geometry: float, wear: float, mode: str,
             "geometry_old": float(geometry), "wear_old": float(wear)}
 
 
-# --- rotating spindle (math §14.2, spec §7.3 [I]) --------------------------------------------
+# --- rotating spindle (measuring-math §14.2, jog-measuring §7.3 [I]) --------------------------------------------
 
 @dataclass(frozen=True)
 class SpindleFeeds:
@@ -161,13 +164,13 @@ class SpindleFeeds:
 def spindle_speed_feeds(radius: float, max_surface_speed: float = 100.0, max_speed: float = 1000.0,
                         accuracy: float = 0.01, min_feed: float = 1.0, max_feed: float = 20.0,
                         factor1: float = 10.0, factor2: float = 0.0) -> SpindleFeeds:
-    """n = min(E_MESS_MAX_S, E_MESS_MAX_V/(2π·r·0.001)), F = n·E_MESS_MIN_D (math §14.2);
+    """n = min(E_MESS_MAX_S, E_MESS_MAX_V/(2π·r·0.001)), F = n·E_MESS_MIN_D (measuring-math §14.2);
     1st probing min(E_MESS_MAX_F, max(E_MESS_MIN_F, E_MESS_F_FAK1·F)); E_MESS_F_FAK2 > 0: a
-    2nd probing at FAK2·F; last at F (spec §7.3 [I]). Radius 0 -> 61351."""
+    2nd probing at FAK2·F; last at F (jog-measuring §7.3 [I]). Radius 0 -> 61351."""
     if radius <= 0.0:
-        raise MeasuringError(61351, "Tool length or radius is 0")
-    speed = min(max_speed, max_surface_speed / (2.0 * math.pi * radius * 0.001))   # §14.2
-    final = speed * accuracy                                                        # §14.2 F = n·Δ
+        raise MeasuringError(alarms.TOOL_SIZE_ZERO, "Tool length or radius is 0")
+    speed = min(max_speed, max_surface_speed / (2.0 * math.pi * radius * 0.001))   # measuring-math §14.2
+    final = speed * accuracy                                                        # measuring-math §14.2 F = n·Δ
     feeds = [min(max_feed, max(min_feed, factor1 * final))]
     if factor2 > 0.0:
         feeds.append(factor2 * final)
@@ -177,7 +180,7 @@ def spindle_speed_feeds(radius: float, max_surface_speed: float = 100.0, max_spe
 
 def compensation_table_value(table: Sequence[Sequence[float]], radius: float, surface_speed: float
                              ) -> float:
-    """_MT_EC_R/_MT_EC_L lookup (math §14.3): row 0 = [0, R1..R4], column 0 of rows 1.. = v1..;
+    """_MT_EC_R/_MT_EC_L lookup (measuring-math §14.3): row 0 = [0, R1..R4], column 0 of rows 1.. = v1..;
     take the next table radius and speed (smallest >= actual, clamped to the last); the value is
     subtracted from the measured radius/length by the caller."""
     t = np.asarray(table, dtype=float)
@@ -188,8 +191,8 @@ def compensation_table_value(table: Sequence[Sequence[float]], radius: float, su
     return float(t[row + 1, col + 1])
 
 
-def evaluate_tool_task(task: str, params: dict, point, plane: Plane, tool_probe: dict[str, float] | None,
-                       tool: dict | None = None) -> tuple[dict, dict]:
+def evaluate_tool_task(task: str, params: dict[str, Any], point: object, plane: Plane, tool_probe: dict[str, float] | None,
+                       tool: dict[str, Any] | None = None) -> tuple[dict[str, Any], dict[str, Any]]:
     """``toolprobe.calibrate`` / ``tool.length`` / ``tool.diameter`` (design.md §4).
 
     toolprobe.calibrate -> (new _TP record, values {"tool_probe", "difference", "center"}).
@@ -220,7 +223,7 @@ def evaluate_tool_task(task: str, params: dict, point, plane: Plane, tool_probe:
     return tool, values
 
 
-def latch_delay_correction(stage_tips: Sequence, key: str, feeds: Sequence[float], override: float,
+def latch_delay_correction(stage_tips: Sequence[npt.ArrayLike | None], key: str, feeds: Sequence[float], override: float,
                            cal_feed: float, cal_override: float, min_feed_spread: float = 1.0
                            ) -> tuple[float | None, float]:
     """Signal delay t [s] of a flying tool measurement and the correction (v_meas − v_cal)·t.

@@ -6,17 +6,39 @@ name says otherwise. Vectors are numpy arrays of shape (3,) in X, Y, Z order.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
+import numpy.typing as npt
+
+from engine.alarms import AlarmDef
+
+if TYPE_CHECKING:                      # engine.lobing needs nothing from here
+    from _typeshed import DataclassInstance
+
+    from engine.lobing import LobingMap
+
+_Point = TypeVar("_Point", bound="DataclassInstance")   # a stored point (value dataclass)
+_T = TypeVar("_T")
+
+# the engine's vectors (shape (3,)), matrices and point lists: float64 arrays
+FloatArray = npt.NDArray[np.float64]
 
 
 class MeasuringError(Exception):
-    """A measurement that cannot give a result; ``alarm`` is the manual's alarm number."""
+    """A measurement that cannot give a result: an alarm of ``engine.alarms`` and what happened.
 
-    def __init__(self, alarm: int, message: str):
-        super().__init__(f"{alarm}: {message}")
-        self.alarm = alarm
+    ``alarm`` is the manual's alarm number, ``definition`` the catalogue entry (text, remedy).
+    """
+
+    def __init__(self, alarm: AlarmDef, message: str):
+        if not isinstance(alarm, AlarmDef):
+            raise TypeError(f"MeasuringError needs an engine.alarms entry, got {alarm!r}")
+        super().__init__(f"{alarm.number}: {message}")
+        self.definition = alarm
+        self.alarm = alarm.number
         self.message = message
 
 
@@ -44,6 +66,9 @@ class ProbeRecord:
     calibrated_length: bool = False
     calibration_feed: float | None = None
     calibration_override: float | None = None
+    # the direction-dependent trigger map of an n-direction ring calibration (engine.lobing,
+    # design.md §9.8): every touch's surface point then follows it; None: the trigger values
+    lobing: LobingMap | None = field(default=None, compare=False)
 
 
 # --- what one measuring point stores (P1..P4) ------------------------------------------
@@ -52,10 +77,10 @@ class ProbeRecord:
 class Touch:
     """One compensated probing: ball centre at switching, probing direction, surface point."""
 
-    ball_centre: np.ndarray      # compensated ball-centre estimate c = rec + skew (WCS)
-    direction: np.ndarray        # unit travel direction (WCS)
-    surface: np.ndarray          # point-wise surface estimate s (measuring-math §5.3)
-    latched_mcs: np.ndarray | None = None  # raw axis positions, for the log
+    ball_centre: FloatArray      # compensated ball-centre estimate c = rec + skew (WCS)
+    direction: FloatArray        # unit travel direction (WCS)
+    surface: FloatArray          # point-wise surface estimate s (measuring-math §5.3)
+    latched_mcs: FloatArray | None = None  # raw axis positions, for the log
 
 
 @dataclass(frozen=True)
@@ -69,7 +94,7 @@ class EdgePoint:
 class CirclePoint:
     """A stored hole/spigot centre (4 touches, circle fit)."""
 
-    center: np.ndarray           # WCS; infeed coordinate = measuring height
+    center: FloatArray           # WCS; infeed coordinate = measuring height
     diameter: float
     touches: tuple[Touch, ...] = ()
 
@@ -78,7 +103,7 @@ class CirclePoint:
 class RectPoint:
     """A stored rectangular pocket/spigot centre (4 touches)."""
 
-    center: np.ndarray
+    center: FloatArray
     length: float                # along the plane's 1st axis
     width: float                 # along the plane's 2nd axis
     touches: tuple[Touch, ...] = ()
@@ -104,12 +129,12 @@ class FeatureFix:
     angle: float | None = None
     angle_axis: str | None = None
     reference_axis: str | None = None
-    normal: np.ndarray | None = None
+    normal: FloatArray | None = None
     # full 3D reference point in the measuring WCS (e.g. the surface point of set edge, the
     # corner/centre at measuring height); its undetermined components place the feature when
     # the target system is rotated against the measuring WCS (jog-measuring §2.5.1 [I] uses
     # the 3D contact point). ``position`` overrides its determined axes. None = zeros.
-    point: np.ndarray | None = None
+    point: FloatArray | None = None
 
 
 @dataclass(frozen=True)
@@ -117,7 +142,7 @@ class TaskResult:
     """``values``: the design.md §4 result keys (JSON-ready). ``fix``: input to correction."""
 
     task: str
-    values: dict
+    values: dict[str, Any]
     fix: FeatureFix
 
 
@@ -131,7 +156,7 @@ class MoveStep:
     None = rapid. ``monitored``: collision-monitored (a switch -> alarm 61302).
     """
 
-    target: np.ndarray
+    target: FloatArray
     feed: float | None
     monitored: bool = True
     coords: str = "WCS"
@@ -142,7 +167,7 @@ class MoveStep:
 class ProbeStep:
     """Measuring move from the current position along ``direction`` over ``distance``."""
 
-    direction: np.ndarray
+    direction: FloatArray
     distance: float
     feed: float
     coords: str = "WCS"
@@ -171,5 +196,78 @@ class Latch:
     """
 
     triggered: bool
-    rec: np.ndarray | None = None
-    latched_mcs: np.ndarray | None = None
+    rec: FloatArray | None = None
+    latched_mcs: FloatArray | None = None
+
+
+if TYPE_CHECKING:
+    class HitLatch(Latch):
+        """A Latch that switched, as ``engine.plan_base.hit`` checks it: ``rec`` is set.
+
+        For the type checker only (no such class at run time: the objects are Latch)."""
+
+        rec: FloatArray
+
+
+# --- moving a stored point between measuring systems ------------------------------------------
+
+_POSITION_FIELDS = ("ball_centre", "surface", "center")
+
+
+def translated(point: _Point, delta: npt.ArrayLike) -> _Point:
+    """The stored point (EdgePoint, CirclePoint, RectPoint, Touch) shifted by ``delta`` (WCS mm).
+
+    For points taken in measuring systems that differ by a translation only: positions move,
+    directions and sizes stay, raw machine positions (``latched_mcs``) stay as latched."""
+    shift = np.asarray(delta, dtype=float)
+    changes: dict[str, Any] = {}
+    for name in _POSITION_FIELDS:
+        value = getattr(point, name, None)
+        if value is not None:
+            changes[name] = np.asarray(value, dtype=float) + shift
+    touch = getattr(point, "touch", None)
+    if isinstance(touch, Touch):
+        changes["touch"] = translated(touch, shift)
+    touches = getattr(point, "touches", None)
+    if touches:
+        changes["touches"] = tuple(translated(t, shift) for t in touches)
+    return replace(point, **changes) if changes else point
+
+
+def averaged(points: Iterable[_T]) -> _T:
+    """The mean of the same point measured n times at the same place (_NMSP, measuring-math §1.4).
+
+    Field by field: arrays and numbers are averaged, nested value objects and their tuples
+    recursively, everything else (directions' labels, keys, flags) must agree. Directions stay
+    unit vectors (the mean of equal directions)."""
+    taken = list(points)
+    if not taken:
+        raise ValueError("averaged() needs at least one point")
+    if len(taken) == 1:
+        return taken[0]
+    mean: _T = _mean_of(taken)
+    return mean
+
+
+def _mean_of(values: Sequence[Any]) -> Any:      # any field type of the stored points
+    first = values[0]
+    if first is None:
+        return None
+    if isinstance(first, bool) or isinstance(first, str | int) and not isinstance(first, float):
+        if any(v != first for v in values):
+            raise ValueError(f"measurements at one place disagree: {values!r}")
+        return first
+    if isinstance(first, float | np.floating):
+        return float(np.mean(values))
+    if isinstance(first, np.ndarray):
+        return np.mean(np.stack([np.asarray(v, dtype=float) for v in values]), axis=0)
+    if isinstance(first, tuple | list):
+        if any(len(v) != len(first) for v in values):
+            raise ValueError("measurements at one place have different numbers of touches")
+        return type(first)(_mean_of([v[i] for v in values]) for i in range(len(first)))
+    if isinstance(first, dict):
+        return {key: _mean_of([v[key] for v in values]) for key in first}
+    if hasattr(first, "__dataclass_fields__"):
+        return replace(first, **{name: _mean_of([getattr(v, name) for v in values])
+                                 for name in first.__dataclass_fields__})
+    raise TypeError(f"cannot average {type(first).__name__}")

@@ -1,12 +1,25 @@
 #!/usr/bin/env bash
-# Install whatever is missing (Debian chromium, the virtual environment and the Python
-# packages) and run every test: lint, unit, property, API and Playwright end-to-end.
+# Install whatever is missing (Debian chromium and LinuxCNC, the virtual environment and the
+# Python packages) and run every test: lint, unit, property, API and Playwright end-to-end.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+if [ "$(id -u)" = 0 ]; then SUDO=""; else SUDO="sudo"; fi
+APT_UPDATED=""
+apt_install() {    # Debian packages, one apt-get update per run at most
+    if [ -z "$APT_UPDATED" ]; then $SUDO apt-get update -qq; APT_UPDATED=1; fi
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "$@" >/dev/null
+}
 if [ ! -x /usr/bin/chromium ]; then
-    if [ "$(id -u)" = 0 ]; then SUDO=""; else SUDO="sudo"; fi
-    $SUDO apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq chromium >/dev/null
+    apt_install chromium
+fi
+# LinuxCNC for `--machine linuxcnc` and tests/linuxcnc (its python module, halcompile and a C
+# compiler for the probe comparator); no recommends: they would bring a realtime kernel
+if [ ! -x /usr/bin/linuxcnc ] || [ ! -x /usr/bin/halcompile ] || [ ! -x /usr/bin/gcc ]; then
+    apt_install --no-install-recommends linuxcnc-uspace linuxcnc-uspace-dev gcc make
+fi
+# a Chinese font: the ZH screens and the manual's texts in Chromium (else empty boxes)
+if [ ! -d /usr/share/fonts/truetype/wqy ]; then
+    apt_install --no-install-recommends fonts-wqy-microhei
 fi
 if [ ! -x .venv/bin/python ]; then
     python3 -m venv .venv
@@ -14,4 +27,6 @@ fi
 .venv/bin/pip install -q --upgrade pip
 .venv/bin/pip install -q -e '.[test]'
 .venv/bin/ruff check app engine db tests bench
+# types (pyproject [tool.mypy]): engine/ and db/ strict, app/ with its untyped defs checked
+.venv/bin/mypy
 exec .venv/bin/python -m pytest "$@"

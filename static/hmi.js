@@ -1,6 +1,165 @@
-// Only what htmx cannot do: keyboard shortcuts, NC Start dispatch, press-and-hold continuous jog.
+// Only what htmx cannot do: keyboard shortcuts, NC Start dispatch, the tab's own control panel,
+// hold-to-run jogging and the connection state. URLs come from the page (data-url of #nc-start,
+// data-jog-start/-stop of #mcp), made from route names.
 (function () {
   "use strict";
+
+  // --- the control panel of this tab (axis, increment, WCS/MCS): kept in sessionStorage and
+  // sent with every request, so two tabs never share a selection (design.md §9.1)
+  var PANEL_KEY = "hmi-panel";
+  var panel = (function () {
+    try { return JSON.parse(sessionStorage.getItem(PANEL_KEY)) || {}; } catch (e) { return {}; }
+  })();
+  function savePanel() {
+    try { sessionStorage.setItem(PANEL_KEY, JSON.stringify(panel)); } catch (e) { /* private mode */ }
+  }
+  // a panel key pressed while the panel's previous answer is on its way is pressed again on the
+  // new panel (the old one, and a request from it, are gone with the swap: the key would be lost)
+  var panelBusy = false, pendingKey = null;
+  document.addEventListener("click", function (event) {     // capture: before htmx sends the request
+    var key = event.target.closest("#mcp [data-axis], #mcp [data-increment], #position [data-coords]");
+    if (!key) return;
+    if (panelBusy && key.closest("#mcp")) {
+      event.preventDefault();
+      event.stopImmediatePropagation();
+      pendingKey = key.dataset.axis ? '[data-axis="' + key.dataset.axis + '"]'
+                                    : '[data-increment="' + key.dataset.increment + '"]';
+      return;
+    }
+    if (key.dataset.axis) panel.axis = key.dataset.axis;
+    if (key.dataset.increment) panel.increment = key.dataset.increment;
+    if (key.dataset.coords) panel.coords = key.dataset.coords;
+    savePanel();
+  }, true);
+  function isPanelKey(elt) {
+    return !!(elt && elt.closest && elt.closest("#mcp") && (elt.dataset.axis || elt.dataset.increment));
+  }
+  var panelSince = 0;
+  document.addEventListener("htmx:beforeRequest", function (event) {
+    if (!isPanelKey(event.detail.elt)) return;
+    event.detail.xhr.hmiPanel = true;        // the old key may be gone when the answer comes
+    panelBusy = true;
+    panelSince = Date.now();
+  });
+  setInterval(function () {                  // never hold the panel's keys for longer than 2 s
+    if (panelBusy && Date.now() - panelSince > 2000) { panelBusy = false; pendingKey = null; }
+  }, 500);
+  document.addEventListener("htmx:afterRequest", function (event) {
+    if (!(event.detail.xhr && event.detail.xhr.hmiPanel)) return;
+    setTimeout(function () {                                 // after the swap has settled
+      panelBusy = false;
+      var next = pendingKey && document.querySelector("#mcp button" + pendingKey);
+      pendingKey = null;
+      if (next) next.click();
+    }, 30);
+  });
+  document.addEventListener("htmx:configRequest", function (event) {
+    var headers = event.detail.headers;
+    if (panel.axis) headers["X-Panel-Axis"] = panel.axis;
+    if (panel.increment) headers["X-Panel-Increment"] = panel.increment;
+    if (panel.coords) headers["X-Panel-Coords"] = panel.coords;
+  });
+  function restorePanel() {     // a page load renders the defaults: show this tab's selection
+    var mcp = document.getElementById("mcp");
+    var position = document.getElementById("position-values");
+    if (mcp && ((panel.axis && mcp.dataset.axis !== panel.axis) ||
+                (panel.increment && mcp.dataset.increment !== panel.increment))) {
+      htmx.ajax("POST", mcp.dataset.panelUrl, { target: "#mcp", swap: "outerHTML",
+                                                values: { increment: panel.increment || mcp.dataset.increment } });
+    }
+    if (position && panel.coords && position.dataset.coords !== panel.coords) {
+      htmx.ajax("POST", position.dataset.coordsUrl, { target: "#position", swap: "outerHTML",
+                                                      values: { coords: panel.coords } });
+    }
+  }
+  document.addEventListener("DOMContentLoaded", restorePanel);
+
+  // --- connection: a failed or late request, or a live feed that went quiet (static/live.js), shows
+  // that the machine is not reached (no stale "stopped"); the next answer clears it
+  var lost = false;
+  function connection(ok) {
+    if (ok === !lost) return;
+    lost = !ok;
+    document.body.classList.toggle("offline", lost);
+    var banner = document.getElementById("connection");
+    if (banner) banner.hidden = !lost;
+  }
+  ["htmx:sendError", "htmx:timeout"].forEach(function (name) {
+    document.addEventListener(name, function () { connection(false); });
+  });
+  document.addEventListener("htmx:afterRequest", function (event) {
+    var xhr = event.detail.xhr;
+    if (xhr && xhr.status > 0 && xhr.status < 500) connection(true);
+    else if (xhr && xhr.status >= 500) connection(false);
+  });
+  // the live feed (static/live.js) says when its events stop and come back
+  document.addEventListener("hmi:connection", function (event) { connection(event.detail.ok); });
+  document.addEventListener("htmx:responseError", function (event) {    // 4xx/5xx: say why
+    var message = document.getElementById("message");
+    var xhr = event.detail.xhr;
+    if (!message || !xhr) return;
+    try {
+      var body = JSON.parse(xhr.responseText);
+      if (body && body.error) {
+        message.textContent = body.error.message;
+        message.className = "message error";
+      }
+    } catch (e) { /* an HTML answer swaps itself */ }
+  });
+
+  // --- a new correction target re-renders the measuring screen, and a set-up support answer its
+  // screen, with the form as it was sent: what the operator typed or chose while that answer was
+  // on its way is put back (nothing typed is lost); on set-up support it is then sent again, since
+  // the screen's texts follow the answers
+  var RESENT_FORMS = { "setup-form": true };
+  function formValues(form) {
+    var values = {};
+    new FormData(form).forEach(function (value, name) { values[name] = String(value); });
+    return values;
+  }
+  function refreshingForm(event) {
+    var elt = event.detail.elt;
+    if (!elt || !elt.form) return null;
+    var id = elt.form.id;
+    return (id === "task-form" && elt.name === "target") || (RESENT_FORMS[id] && elt.name) ? elt.form : null;
+  }
+  document.addEventListener("htmx:beforeRequest", function (event) {
+    var form = refreshingForm(event);
+    if (form) event.detail.xhr.hmiSent = { form: form.id, by: event.detail.elt.name, values: formValues(form) };
+  });
+  document.addEventListener("htmx:beforeSwap", function (event) {
+    var sent = event.detail.xhr && event.detail.xhr.hmiSent;
+    var form = sent && document.getElementById(sent.form);
+    if (!form) return;
+    var now = formValues(form), changed = {};
+    Object.keys(now).forEach(function (name) {
+      if (name !== sent.by && now[name] !== sent.values[name]) changed[name] = now[name];
+    });
+    if (Object.keys(changed).length) event.detail.xhr.hmiChanged = { form: sent.form, values: changed };
+  });
+  document.addEventListener("htmx:afterSettle", function (event) {
+    var changed = event.detail.xhr && event.detail.xhr.hmiChanged;
+    var form = changed && document.getElementById(changed.form);
+    if (!form) return;
+    delete event.detail.xhr.hmiChanged;
+    var first = null;
+    Object.keys(changed.values).forEach(function (name) {
+      var value = changed.values[name];
+      form.querySelectorAll('[name="' + CSS.escape(name) + '"]').forEach(function (control) {
+        if (control.closest(".field.locked") || control.disabled && control.type !== "radio") return;
+        if (control.tagName === "SELECT" && !control.querySelector('option[value="' + CSS.escape(value) + '"]')) return;
+        if (control.type === "radio") {
+          control.checked = control.value === value;
+          var choice = control.closest(".pos-choice");
+          if (choice) choice.classList.toggle("on", control.checked);
+        } else {
+          control.value = value;
+        }
+        first = first || control;
+      });
+    });
+    if (first && RESENT_FORMS[changed.form]) htmx.trigger(first, "change");
+  });
 
   function post(url, data) {
     // htmx.ajax swaps the answer (the message block) out of band, like a normal htmx request
@@ -30,33 +189,50 @@
   // --- NC Start: a measuring screen marks its start element with data-ncstart and
   // hx-trigger="ncstart"; without one NC Start has no function here (JOG basic screen).
   document.addEventListener("click", function (event) {
-    if (!event.target.closest("#nc-start")) return;
+    var key = event.target.closest("#nc-start");
+    if (!key) return;
     var target = document.querySelector("#screen [data-ncstart]");
     if (target) htmx.trigger(target, "ncstart");
-    else post("/ui/ncstart");
+    else post(key.dataset.url);
   });
 
-  // --- continuous jog: press and hold (only when the MCP is in "Cont" mode)
-  var holding = null;
+  // --- continuous jog: press and hold (only when the MCP is in "Cont" mode). Hold-to-run: the
+  // jog is renewed every RENEW_MS while the key is held; the server stops the axis 0.5 s after
+  // the last renewal, so a lost tab, network or server stops it too (design.md §9.1)
+  var RENEW_MS = 150;
+  var holding = null;     // {key, stop, timer}
   function release() {
     if (!holding) return;
-    holding.classList.remove("pressed");
+    holding.key.classList.remove("pressed");
+    clearInterval(holding.timer);
+    var stop = holding.stop;
     holding = null;
-    post("/ui/jog/stop");
+    post(stop);
   }
   document.addEventListener("pointerdown", function (event) {
     var key = event.target.closest("#mcp[data-increment='cont'] [data-jog]");
     if (!key) return;
     event.preventDefault();
-    holding = key;
+    var mcp = key.closest("#mcp");
+    var start = { url: mcp.dataset.jogStart, values: { direction: key.dataset.jog, axis: mcp.dataset.axis } };
     key.classList.add("pressed");
     if (key.setPointerCapture) key.setPointerCapture(event.pointerId);
-    post("/ui/jog/start", { direction: key.dataset.jog });
+    post(start.url, start.values);
+    holding = { key: key, stop: mcp.dataset.jogStop,
+                timer: setInterval(function () { post(start.url, start.values); }, RENEW_MS) };
   });
   ["pointerup", "pointercancel", "lostpointercapture"].forEach(function (name) {
     document.addEventListener(name, release);
   });
   window.addEventListener("blur", release);
+  document.addEventListener("visibilitychange", function () { if (document.hidden) release(); });
+  window.addEventListener("pagehide", release);
+
+  // --- forms that only htmx triggers (data-no-submit): Enter in a field submits nothing (in place of
+  // an hx-on attribute, which the Content-Security-Policy's script-src 'self' does not run)
+  document.addEventListener("submit", function (event) {
+    if (event.target.closest("[data-no-submit]")) event.preventDefault();
+  });
 
   // --- feed override: show the value while the slider moves
   document.addEventListener("input", function (event) {

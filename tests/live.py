@@ -32,8 +32,10 @@ def free_port() -> int:
 
 
 @contextmanager
-def serve(root: Path, scenario: dict, start_timeout_s: float = 15.0) -> Iterator[str]:
-    """Serve the app on a free loopback port with a fresh db under ``root``; yields the base URL."""
+def serve(root: Path, scenario: dict, start_timeout_s: float = 15.0, settings: dict | None = None,
+          prepare=None) -> Iterator[str]:
+    """Serve the app on a free loopback port with a fresh db under ``root``; yields the base URL.
+    ``settings``: more ``Settings`` fields; ``prepare(app)`` runs before the start (users, ...)."""
     import uvicorn
 
     from app.config import Settings
@@ -43,7 +45,9 @@ def serve(root: Path, scenario: dict, start_timeout_s: float = 15.0) -> Iterator
     scenario_path = root / "scenario.json"
     scenario_path.write_text(json.dumps(scenario))
     port = free_port()
-    app = create_app(Settings(db_path=root / "hmi.db", scenario_path=scenario_path, port=port))
+    app = create_app(Settings(db_path=root / "hmi.db", scenario_path=scenario_path, port=port, **(settings or {})))
+    if prepare is not None:
+        prepare(app)
     server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
     thread = threading.Thread(target=server.run, daemon=True)
     thread.start()

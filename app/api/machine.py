@@ -4,50 +4,54 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from fastapi import APIRouter, Body, Request
-from pydantic import BaseModel, ConfigDict, Field, StrictInt, StrictStr
+from fastapi import APIRouter, Body, Query, Request
+from pydantic import BaseModel, ConfigDict, Field, StrictFloat, StrictInt, StrictStr
 
+from app.access.deps import needs
 from app.deps import MachineDep
 from app.errors import InvalidInput
 from app.machine.scenario import load_scenario
+from app.records import MAX_TOOL
+from app.services import trainer
 from app.services.scenarios import with_time_scale
 
 router = APIRouter(tags=["machine"])
 
 
 class _Body(BaseModel):
+    # JSON booleans are never numbers (design.md §9.1): every number is a StrictFloat/StrictInt
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
 
 class JogBody(_Body):
     axis: str
-    distance: float
-    feed: float | None = None
+    distance: StrictFloat
+    feed: StrictFloat | None = None
 
 
 class ContinuousJogBody(_Body):
     axis: str
     direction: Literal[-1, 1]
-    feed: float | None = None
+    feed: StrictFloat | None = None
 
 
 class GotoBody(_Body):
-    X: float | None = None
-    Y: float | None = None
-    Z: float | None = None
-    A: float | None = None
-    B: float | None = None
-    C: float | None = None
+    X: StrictFloat | None = None
+    Y: StrictFloat | None = None
+    Z: StrictFloat | None = None
+    A: StrictFloat | None = None
+    B: StrictFloat | None = None
+    C: StrictFloat | None = None
     coords: Literal["WCS", "MCS"] = "WCS"
-    feed: float | None = None
+    feed: StrictFloat | None = None
 
 
 class OverrideBody(_Body):
-    feed: float = Field(ge=0, le=120)
+    feed: StrictFloat = Field(ge=0, le=120)
 
 
 class ToolBody(_Body):
-    tool: StrictInt | StrictStr | None
+    tool: Annotated[StrictInt, Field(ge=0, le=MAX_TOOL)] | StrictStr | None
 
 
 class ActivateBody(_Body):
@@ -55,76 +59,97 @@ class ActivateBody(_Body):
 
 
 class ProbeBody(_Body):
-    direction: list[float] = Field(min_length=3, max_length=3)
-    distance: float
-    feed: float
+    direction: list[StrictFloat] = Field(min_length=3, max_length=3)
+    distance: StrictFloat
+    feed: StrictFloat
     coords: Literal["WCS", "MCS"] = "MCS"
 
 
-@router.get("/health")
+@router.get("/health", name="api_health")
 def health() -> dict:
     return {"status": "ok"}
 
 
-@router.get("/machine")
+@router.get("/machine", name="api_machine")
 def machine_state(machine: MachineDep) -> dict:
     return machine.status()
 
 
-@router.post("/machine/jog")
+@router.post("/machine/jog", name="api_machine_jog", dependencies=[needs("jog")])
 def jog(body: JogBody, machine: MachineDep) -> dict:
     return machine.jog(body.axis, body.distance, body.feed)
 
 
-@router.post("/machine/jog/continuous")
+@router.post("/machine/jog/continuous", name="api_machine_jog_continuous", dependencies=[needs("jog")])
 def jog_continuous(body: ContinuousJogBody, machine: MachineDep) -> dict:
     """Starts a continuous jog that runs until ``/machine/stop``, Reset or a limit/alarm."""
     return machine.jog_continuous(body.axis, body.direction, body.feed)
 
 
-@router.post("/machine/stop")
+@router.post("/machine/stop", name="api_machine_stop", dependencies=[needs("view")])   # stopping is never locked
 def stop(machine: MachineDep) -> dict:
     return machine.stop()
 
 
-@router.post("/machine/goto")
+@router.post("/machine/goto", name="api_machine_goto", dependencies=[needs("jog")])
 def goto(body: GotoBody, machine: MachineDep) -> dict:
     target = body.model_dump(include={"X", "Y", "Z", "A", "B", "C"}, exclude_none=True)
     return machine.goto(target, body.coords, body.feed)
 
 
-@router.post("/machine/reset")
+@router.post("/machine/reset", name="api_machine_reset", dependencies=[needs("view")])  # Reset is never locked
 def reset(machine: MachineDep) -> dict:
     return machine.reset()
 
 
-@router.put("/machine/override")
+@router.put("/machine/override", name="api_machine_override", dependencies=[needs("jog")])
 def override(body: OverrideBody, machine: MachineDep) -> dict:
     return machine.set_override(body.feed)
 
 
-@router.post("/machine/tool")
+@router.post("/machine/tool", name="api_machine_tool", dependencies=[needs("jog")])
 def tool_change(body: ToolBody, machine: MachineDep) -> dict:
     return machine.change_tool(body.tool)
 
 
-@router.post("/machine/activate")
+@router.post("/machine/activate", name="api_machine_activate", dependencies=[needs("jog")])
 def activate(body: ActivateBody, machine: MachineDep) -> dict:
     return machine.activate(body.offset)
 
 
-@router.post("/machine/probe")
+@router.post("/machine/probe", name="api_machine_probe", dependencies=[needs("jog")])
 def probe(body: ProbeBody, machine: MachineDep) -> dict:
     return machine.probe(body.direction, body.distance, body.feed, body.coords)
 
 
-@router.get("/machine/scene")
-def scene(machine: MachineDep) -> dict:
-    """The true scene (MCS) for the machine view: block, circles, rects, probe."""
-    return machine.scene_geometry()
+@router.get("/machine/scene", name="api_machine_scene")
+def scene(request: Request) -> dict:
+    """The true scene (MCS) for the machine view: block, circles, rects, probe. With the setting
+    ``trainer_hide_part`` only the fixtures and the probe where the NC puts it (``"hidden": true``)."""
+    return trainer.visible_scene(request.app.state.services)
 
 
-@router.post("/sim/scenario")
+@router.get("/sim/setup-error", name="api_sim_setup_error")
+def setup_error(request: Request, offset: Annotated[str | None, Query(max_length=16)] = None) -> dict:
+    """The trainer's answer: the stored zero offset (default: the active one) against the hidden
+    part, computed by the simulator. ``error`` = stored entries − those of the right set-up (the
+    part's nearest reference point at the WCS zero, ``reference``), mm and degrees."""
+    return trainer.setup_error(request.app.state.services, offset)
+
+
+class MachinePartBody(_Body):
+    scatter_sigma: StrictFloat = Field(0.0, ge=0.0, le=1.0, description="scatter of the cut sizes, mm (1σ)")
+
+
+@router.post("/sim/machine-part", name="api_sim_machine_part", dependencies=[needs("scenario")])
+def machine_part(machine: MachineDep, body: Annotated[MachinePartBody | None, Body()] = None) -> dict:
+    """The next part of the machined-part series replaces the workpiece (design.md §9.3): its
+    features made by ``machined_by`` tools are cut with the tools' true size against the tool
+    data the control holds now; then the tools wear by ``wear_per_part``."""
+    return machine.machine_part((body or MachinePartBody()).scatter_sigma)
+
+
+@router.post("/sim/scenario", name="api_sim_scenario", dependencies=[needs("scenario")])
 def load(request: Request, machine: MachineDep, body: Annotated[dict, Body()]) -> dict:
     data = dict(body)
     reset_data = data.pop("reset_data", False)
@@ -135,4 +160,7 @@ def load(request: Request, machine: MachineDep, body: Annotated[dict, Body()]) -
     except ValueError as exc:
         raise InvalidInput(str(exc), code="invalid_scenario") from None
     scenario = with_time_scale(scenario, request.app.state.settings.time_scale)
-    return machine.load_scenario(scenario, reset_data=reset_data)
+    answer = machine.load_scenario(scenario, reset_data=reset_data)
+    with request.app.state.services.db.unit() as unit:       # who loaded it (and wiped the data)
+        unit.add_audit("scenario", "scenario", None, {"reset_data": reset_data, "seed": data.get("seed")}, "api")
+    return answer

@@ -6,7 +6,8 @@ from __future__ import annotations
 from fastapi import APIRouter
 from pydantic import BaseModel, ConfigDict, Field
 
-from app.deps import ServicesDep
+from app.access.deps import needs
+from app.deps import ServicesDep, WorkflowDep
 from app.workflow import setup_support
 
 router = APIRouter(prefix="/measure", tags=["measure"])
@@ -20,20 +21,21 @@ class CarryOutBody(BaseModel):
     position_rotary: bool = Field(True, description="turn the rotary axis to align the workpiece")
 
 
-@router.get("/{session_id}/setup-support")
-def setup_support_screen(session_id: str, services: ServicesDep) -> dict:
+@router.get("/{session_id}/setup-support", name="api_setup_support")
+def setup_support_screen(session_id: str, services: ServicesDep, workflow: WorkflowDep) -> dict:
     """The activation screen: results, corrected WO, toggle fields, texts."""
-    return setup_support.screen_model(services.workflow, services.machine, session_id)
+    return setup_support.screen_model(workflow, services.machine, session_id)
 
 
-@router.post("/{session_id}/setup-support")
-def carry_out(session_id: str, services: ServicesDep, body: CarryOutBody | None = None) -> dict:
+@router.post("/{session_id}/setup-support", name="api_setup_support_carry_out", dependencies=[needs("jog")])
+def carry_out(session_id: str, services: ServicesDep, workflow: WorkflowDep,
+              body: CarryOutBody | None = None) -> dict:
     """NC Start on the activation screen."""
     choices = setup_support.Choices(**(body or CarryOutBody()).model_dump())
-    return setup_support.carry_out(services.workflow, services.machine, session_id, choices, db=services.db)
+    return setup_support.carry_out(workflow, services.machine, session_id, choices, db=services.db)
 
 
-@router.delete("/{session_id}/setup-support")
-def leave(session_id: str, services: ServicesDep) -> dict:
+@router.delete("/{session_id}/setup-support", name="api_setup_support_leave", dependencies=[needs("measure")])
+def leave(session_id: str, workflow: WorkflowDep) -> dict:
     """``<<``: leave without activating (the written correction stays)."""
-    return setup_support.leave(services.workflow, session_id)
+    return setup_support.leave(workflow, session_id)

@@ -1,4 +1,4 @@
-"""Probe physics of the simulator (measuring-math §1.3, §1.7; design.md §5).
+"""Probe physics of the simulator (measuring-math §1.3, measuring-math §1.7; design.md §5).
 
 Pure functions, no state. Own small rotation helper: the simulator must not import the
 engine (it must not "know the answer" from the same code).
@@ -11,6 +11,17 @@ import math
 import numpy as np
 
 Z_UNIT = np.array([0.0, 0.0, 1.0])
+
+# Probe frame -> MCS at SPOS 0 for each spindle axis (scenario machine.spindle_axis): the probe's
+# own (x, y, z) are the (a, o, p) of the plane whose infeed is the spindle axis (measuring-math
+# measuring-math §0.1): Z -> (X, Y, Z) as G17, Y -> (Z, X, Y) as G18, X -> (Y, Z, X) as G19. Columns = the probe
+# axes in MCS; all three are proper rotations (cyclic permutations), probe z = +spindle axis.
+SPINDLE_MOUNTS = {
+    "Z": np.eye(3),
+    "Y": np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]]),
+    "X": np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]),
+}
+PRETRAVEL_FRAMES = ("probe", "machine")
 
 
 def rpy_matrix(rot_deg) -> np.ndarray:
@@ -31,13 +42,43 @@ def eccentricity_at(eccentricity_xy, spindle_angle_deg: float) -> np.ndarray:
 
 
 def ball_centre(axes_xyz, true_length: float, eccentricity_xy, spindle_angle_deg: float,
-                head=None) -> np.ndarray:
-    """True ball centre = A + R_head·(e(φ) − L·ẑ) (design.md §4 scenario, A = tool reference point,
-    R_head = identity without a swivel head, scenario.SwivelHead)."""
+                head=None, mount=None) -> np.ndarray:
+    """True ball centre = A + R_head·M·(e(φ) − L·ẑ) (design.md §4 scenario, A = tool reference point,
+    R_head = identity without a swivel head, scenario.SwivelHead; M = SPINDLE_MOUNTS[spindle_axis],
+    identity for the vertical spindle)."""
     offset = eccentricity_at(eccentricity_xy, spindle_angle_deg) - true_length * Z_UNIT
+    if mount is not None:
+        offset = np.asarray(mount, dtype=float) @ offset
     if head is not None:
         offset = np.asarray(head, dtype=float) @ offset
     return np.asarray(axes_xyz, dtype=float) + offset
+
+
+def _cos_sin_deg(deg: float) -> tuple[float, float]:
+    """cos/sin of ``deg`` degrees, exact at the multiples of 90° (SPOS 0/90/180/270)."""
+    deg = float(deg) % 360.0
+    exact = {0.0: (1.0, 0.0), 90.0: (0.0, 1.0), 180.0: (-1.0, 0.0), 270.0: (0.0, -1.0)}
+    if deg in exact:
+        return exact[deg]
+    rad = math.radians(deg)
+    return math.cos(rad), math.sin(rad)
+
+
+def probe_rotation(spindle_angle_deg: float, mount=None, head=None) -> np.ndarray:
+    """Probe frame -> MCS: R = R_head·M·Rz(φ).
+
+    The probe body turns with SPOS about its own z (the spindle axis, tip -> spindle) by +φ,
+    counter-clockwise seen from the spindle (right-hand rule), exactly as the eccentricity
+    e(φ) = Rz(φ)·e_true does; M (SPINDLE_MOUNTS) puts the probe on a horizontal spindle, R_head
+    turns it with a swivel head. A direction d given in MCS reads Rᵀ·d in the probe's frame.
+    """
+    c, s = _cos_sin_deg(spindle_angle_deg)
+    rotation = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    if mount is not None:
+        rotation = np.asarray(mount, dtype=float) @ rotation
+    if head is not None:
+        rotation = np.asarray(head, dtype=float) @ rotation
+    return rotation
 
 
 def _axis_rotation(axis: str, deg: float) -> np.ndarray:
@@ -94,6 +135,24 @@ def pretravel_along(direction, table: dict[str, float]) -> float:
             value = table.get("Z-")
         total += d[i] * d[i] * float(value or 0.0)
     return total
+
+
+def lobing_along(direction_probe, harmonics) -> float:
+    """Σ A·cos(n(θ − φ))·(d_x² + d_y²): the lobes of the probe body for a travel d in the probe's
+    own frame, θ its angle in the probe's X/Y plane, weighted like the table's X/Y entries."""
+    d = np.asarray(direction_probe, dtype=float)
+    in_plane = float(d[0] * d[0] + d[1] * d[1])
+    if not harmonics or in_plane == 0.0:
+        return 0.0
+    theta = np.arctan2(d[1], d[0])
+    return in_plane * sum(h.amplitude * float(np.cos(h.order * (theta - np.radians(h.phase)))) for h in harmonics)
+
+
+def pretravel_in_probe(direction_mcs, table: dict[str, float], probe2mcs, harmonics=()) -> float:
+    """p(Rᵀ·d): the pre-travel table keyed by the probe's own axes (plus its lobing harmonics),
+    d in MCS, R = probe_rotation."""
+    d_probe = np.asarray(probe2mcs, dtype=float).T @ np.asarray(direction_mcs, dtype=float)
+    return pretravel_along(d_probe, table) + lobing_along(d_probe, harmonics)
 
 
 def braking_distance(feed_mm_min: float, latency_s: float, decel_m_s2: float, kv: float) -> float:

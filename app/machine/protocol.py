@@ -15,20 +15,29 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-# Alarm numbers used by the machine (spec/jog-measuring.md §10). 61301 "probe not switched" is
-# not one of them: a probe() without a switch is no fault of the machine, the measuring tasks raise it.
-ALARM_PROBE_COLLISION = 61302
-ALARM_LIMIT = 21614            # "software limit switch" style alarm of the NC
-ALARM_PROBE_BROKEN = 61302     # overtravel beyond the permissible deflection (measuring-math §1.3);
-                               # same number as a collision, but not resettable
-ALARM_RESET = 16900            # motion aborted by Reset (informational, cleared by Reset)
+from engine.alarms import AlarmDef
 
 
 @dataclass(frozen=True)
 class Alarm:
+    """An alarm as the machine shows it: the catalogue's number, a text naming what happened.
+
+    The machine raises collisions, a broken probe, limit switches and Reset aborts
+    (``engine.alarms``); "probe not switched" is not one of them: a probe() without a switch is
+    no fault of the machine, the measuring tasks raise it.
+    """
+
     code: int
     text: str
     resettable: bool = True
+
+    @classmethod
+    def of(cls, definition: AlarmDef, text: str | None = None) -> Alarm:
+        """The catalogue entry ``definition`` with an optional text saying what happened."""
+        return cls(definition.number, text or definition.text, definition.resettable)
+
+    def is_(self, definition: AlarmDef) -> bool:
+        return self.code == definition.number and self.resettable == definition.resettable
 
 
 class MachineAlarm(Exception):
@@ -66,7 +75,8 @@ class MachineStatus:
     alarms: tuple[Alarm, ...]
     mode: str = "JOG"
     plane: str = "G17"
-    tool_axis: tuple[float, float, float] = (0.0, 0.0, 1.0)   # MCS unit vector tip -> spindle (swivel head)
+    tool_axis: tuple[float, float, float] = (0.0, 0.0, 1.0)   # MCS unit vector tip -> spindle (swivel head,
+    #                                                           horizontal spindle: scenario machine.spindle_axis)
 
 
 @dataclass(frozen=True)
@@ -91,8 +101,27 @@ class ProbeResult:
 
 @runtime_checkable
 class Machine(Protocol):
+    """What every controller offers the HMI (the simulator now, LinuxCNC later).
+
+    The NC owns what a control owns (design.md, Standards): the active frame, the named zero
+    offsets and the tool data as it holds them; the HMI writes them through this interface and
+    keeps history, audit and log itself. Motion calls block until the motion ends (or is
+    stopped); ``status()`` may be called from any thread meanwhile. Bad arguments (unknown
+    axis, non-finite numbers, malformed data) raise ValueError; faults raise MachineAlarm.
+    tests/contract/test_machine_contract.py is the executable form of this contract.
+    """
+
+    @property
+    def controller(self) -> str:
+        """Which controller this is: "sim", "linuxcnc" (GET /api/machine, design.md §9.6)."""
+
+    @property
+    def axes(self) -> tuple[str, ...]:
+        """Axis names: X, Y, Z, then the rotary axes."""
+
     def status(self) -> MachineStatus: ...
 
+    # --- motion ---------------------------------------------------------------------------
     def jog(self, axis: str, distance: float, feed: float | None = None) -> MoveResult:
         """Incremental jog of one axis by ``distance`` (mm or deg), collision-monitored."""
 
@@ -105,19 +134,27 @@ class Machine(Protocol):
     def goto(self, target_mcs: dict[str, float], feed: float | None = None) -> MoveResult:
         """Straight positioning to ``target_mcs`` (missing axes stay); rapid when feed is None.
 
-        A probe switch on the way stops the axes with alarm 61302 (MoveResult.alarm set).
+        A probe switch on the way stops the axes with a collision alarm (MoveResult.alarm set).
         """
 
     def probe(self, direction, distance: float, feed: float) -> ProbeResult:
         """Measuring move along ``direction`` (MCS unit vector) over ``distance`` at ``feed``."""
 
+    def reset(self) -> None:
+        """Abort any motion and clear resettable alarms."""
+
+    # --- spindle and tool -------------------------------------------------------------------
     def change_tool(self, tool: int | None, offset_length: float) -> None:
         """Put tool ``tool`` into the spindle; the NC uses ``offset_length`` as its L1."""
 
     def set_tool_offset(self, offset_length: float) -> None:
         """Update the active tool's offset length (after a length calibration)."""
 
-    def activate_frame(self, frame: ActiveFrame) -> None: ...
+    def write_tool(self, t: int, data: dict) -> None:
+        """The control's tool data of T ``t``: ``{"type", "length", "radius", "wear": {"length", "radius"}}``.
+
+        A malformed shape raises ValueError naming the field; motion keeps using the offset
+        length of ``change_tool``/``set_tool_offset``."""
 
     def spindle_position(self, angle: float) -> None:
         """SPOS: orient the spindle (the probe's eccentricity turns with it)."""
@@ -125,13 +162,61 @@ class Machine(Protocol):
     def spindle_rotate(self, speed_rpm: float) -> None:
         """Spindle rotation for tool measuring (0 stops it)."""
 
-    def set_override(self, percent: float) -> None: ...
+    def set_override(self, percent: float) -> None:
+        """Feed override 0..120 % (ValueError outside); acts on the feed in effect of every motion."""
 
-    def reset(self) -> None:
-        """Abort any motion and clear resettable alarms."""
+    # --- frames -----------------------------------------------------------------------------
+    def write_offset(self, name: str, frame: dict) -> None:
+        """The control's copy of a named zero offset (G54.., BASIC_n): ``{"trans", "fine", "rot"}``.
 
+        Each part is keyed by axis (``trans``: the machine's axes, ``fine``/``rot``: X, Y, Z). A
+        malformed shape raises ValueError naming the field; a controller that cannot hold
+        ``name`` (or its rotation) raises MachineAlarm before anything changes. Writing does not
+        activate: display and motion follow ``activate_frame``."""
+
+    def activate_frame(self, frame: ActiveFrame) -> None:
+        """Make ``frame`` (the composed WCS -> BCS chain) the one motion and display use."""
+
+    # --- alarms and life cycle -----------------------------------------------------------------
     def post_alarm(self, alarm: Alarm) -> None:
-        """Show an alarm raised by a measuring cycle (61301, 61367..) until Reset."""
+        """Show an alarm raised by a measuring cycle (probe not switched, ...) until Reset."""
+
+    def close(self) -> None:
+        """Stop motion and release the controller (the HMI shuts down)."""
+
+
+@runtime_checkable
+class SwivelHead(Protocol):
+    """Optional: a machine with swivel kinematics (CYCLE800-like re-alignment, jog-measuring §6.2)."""
+
+    def has_swivel(self) -> bool: ...
+
+    def retract_tool_axis(self, distance: float | None = None) -> MoveResult: ...
+
+    def swivel_to_wcs(self, wcs2bcs_rotation, infeed=(0.0, 0.0, 1.0)) -> MoveResult: ...
+
+
+@runtime_checkable
+class SimulatorControl(Protocol):
+    """Only the simulator offers these: its truth (never used for measuring), scenario load and
+    the time scale. The HMI asks ``isinstance(machine, SimulatorControl)`` before using them."""
 
     @property
-    def axes(self) -> tuple[str, ...]: ...
+    def scenario(self): ...
+
+    def load(self, scenario) -> None:
+        """Replace the truth and reset the machine (axes to the start position, probe in spindle)."""
+
+    def scene_geometry(self) -> dict:
+        """The true scene for the machine view (JSON-ready, MCS)."""
+
+    def machine_part(self, scatter_sigma: float = 0.0) -> int:
+        """The next part of a machined-part series replaces the workpiece (design.md §9.3)."""
+
+
+def add_alarm_once(alarms_shown: list[Alarm], alarm: Alarm) -> Alarm:
+    """Append ``alarm`` to a controller's shown alarms unless the same one is shown already (the
+    caller holds its lock); returns it. Shared by every Machine implementation."""
+    if all(a.code != alarm.code or a.text != alarm.text for a in alarms_shown):
+        alarms_shown.append(alarm)
+    return alarm

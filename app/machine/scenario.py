@@ -8,15 +8,20 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Literal, TypeVar
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
+from .lathe_scenario import LatheScenario
+from .polygon import check_simple_polygon, polygon_area
+
 DEMO_SCENARIO_PATH = Path(__file__).with_name("demo_scenario.json")
+LATHE_DEMO_SCENARIO_PATH = Path(__file__).with_name("lathe_demo_scenario.json")
 
 GEOMETRY_AXES = ("X", "Y", "Z")
 ROTARY_AXIS_NAMES = ("A", "B", "C")
 PRETRAVEL_KEYS = ("X+", "X-", "Y+", "Y-", "Z+", "Z-")
+SPINDLE_AXES = ("Z", "Y", "X")
 DEFAULT_LIMITS = {"X": (-2000.0, 2000.0), "Y": (-2000.0, 2000.0), "Z": (-1000.0, 1000.0)}   # generous
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
@@ -49,7 +54,7 @@ class RotaryTable(_Model):
 
 
 class SwivelHead(_Model):
-    """A swivel head (CYCLE800-like re-alignment, spec §6.2): two rotary axes turn the tool.
+    """A swivel head (CYCLE800-like re-alignment, jog-measuring §6.2): two rotary axes turn the tool.
 
     Model (one, kept simple): the head pivots about the tool reference point (spindle nose,
     the MCS X/Y/Z axis position). ``axes`` names the two head axes in alphabetical order
@@ -72,12 +77,14 @@ class SwivelHead(_Model):
     def _pair(cls, value: tuple[str, str]) -> tuple[str, str]:
         if value[0] == value[1]:
             raise ValueError("kinematics.axes: two different rotary axes")
-        return tuple(sorted(value))
+        first, second = sorted(value)
+        return first, second
 
 
 class MachineConfig(_Model):
-    """Axis limits (MCS of the tool reference point), feeds and the braking model (§1.3)."""
+    """Axis limits (MCS of the tool reference point), feeds and the braking model (turning §1.3)."""
 
+    kind: Literal["mill"] = Field("mill", exclude=True)   # "lathe": app.machine.lathe_scenario
     limits: dict[str, Vec2] = Field(default_factory=lambda: dict(DEFAULT_LIMITS))   # axes not given: default
     rapid: Positive = 10000.0          # mm/min
     jog_feed: Positive = 1000.0        # mm/min, jog when no feed is given
@@ -87,6 +94,16 @@ class MachineConfig(_Model):
     time_scale: NonNegative = 1.0      # 1 = real time, 0 = no waiting
     rotary_table: RotaryTable | None = None   # the part turns with this rotary axis (vertical table)
     kinematics: SwivelHead | None = None      # swivel head (None: 3-axis tool axis +Z, no re-alignment)
+    # the spindle's axis (design.md §9.8): the tool points along −spindle_axis from the spindle
+    # nose (tip = A − L·axis); "Y"/"X" = a horizontal spindle (physics.SPINDLE_MOUNTS)
+    spindle_axis: Literal["Z", "Y", "X"] = "Z"
+
+    @model_validator(mode="after")
+    def _spindle_and_head(self) -> MachineConfig:
+        if self.kinematics is not None and self.spindle_axis != "Z":
+            raise ValueError(f"machine.spindle_axis: a swivel head (machine.kinematics) needs the vertical "
+                             f"spindle \"Z\", got {self.spindle_axis!r}")
+        return self
 
     @field_validator("limits")
     @classmethod
@@ -103,6 +120,16 @@ class ProbeNominal(_Model):
     ball_diameter: Positive | None = None
 
 
+class LobeHarmonic(_Model):
+    """One harmonic of a kinematic probe's lobing (design.md §9.8): the pre-travel grows by
+    ``amplitude``·cos(order·(θ − phase)) for a travel at angle θ in the probe's own X/Y plane
+    (a three-legged probe body: order 3)."""
+
+    order: int = Field(ge=1, le=12)
+    amplitude: float = Field(ge=-0.05, le=0.05)           # mm
+    phase: float = Field(0.0, ge=-360.0, le=360.0)      # deg
+
+
 class ProbeConfig(_Model):
     """The 3D workpiece probe (measuring-math §1.7): true values and what the HMI is told."""
 
@@ -112,6 +139,10 @@ class ProbeConfig(_Model):
     eccentricity: Vec2 = (0.0, 0.0)                # ball centre minus spindle axis at SPOS 0
     nominal: ProbeNominal = Field(default_factory=ProbeNominal)
     pretravel: dict[str, NonNegative] = Field(default_factory=dict)   # keys of PRETRAVEL_KEYS
+    # where the pre-travel keys live (design.md §9.8): "probe" = the probe's own axes, turning with
+    # SPOS like the eccentricity (and with a swivel head); "machine" = the machine axes (wave 1)
+    pretravel_frame: Literal["probe", "machine"] = "probe"
+    lobing: list[LobeHarmonic] = Field(default_factory=list, max_length=12)   # on top of ``pretravel``
     noise_sigma: NonNegative = 0.0
     max_deflection: Positive = 2.0
 
@@ -122,6 +153,19 @@ class ProbeConfig(_Model):
         if bad:
             raise ValueError(f"unknown pre-travel direction(s) {bad}; use {list(PRETRAVEL_KEYS)}")
         return value
+
+    @model_validator(mode="after")
+    def _lobing_physical(self) -> ProbeConfig:
+        if not self.lobing:
+            return self
+        if self.pretravel_frame != "probe":
+            raise ValueError("lobing: the lobes belong to the probe body: needs pretravel_frame \"probe\"")
+        smallest = min(self.pretravel.get(k, 0.0) for k in ("X+", "X-", "Y+", "Y-"))
+        swing = sum(abs(h.amplitude) for h in self.lobing)
+        if swing > smallest:
+            raise ValueError(f"lobing: the amplitudes ({swing:g} mm together) exceed the smallest X/Y pre-travel "
+                             f"({smallest:g} mm): a pre-travel cannot be negative")
+        return self
 
     @property
     def nominal_length(self) -> float:
@@ -145,11 +189,50 @@ class Block(_Model):
     size: tuple[Positive, Positive, Positive]     # fills [0,Lx] x [0,Ly] x [-Lz,0] in part coords
 
 
+class Prism(_Model):
+    """A vertical-walled part (design.md §9.8), in place of ``block``: the simple ``polygon``
+    (part x/y, mm; counter-clockwise or clockwise, any shape, convex or not) extruded from the top
+    face z = 0 down to z = −height. Holes, pockets, spigots and bosses go into/onto it as on a block."""
+
+    type: Literal["prism"]
+    polygon: list[Vec2]
+    height: Positive
+
+    @field_validator("polygon")
+    @classmethod
+    def _simple(cls, value: list[tuple[float, float]]) -> list[tuple[float, float]]:
+        check_simple_polygon(value, "polygon")
+        return value
+
+    @property
+    def ccw_polygon(self) -> list[tuple[float, float]]:
+        """The polygon counter-clockwise seen from the part's +z (the normalised orientation)."""
+        pts = [(x, y) for x, y in self.polygon]
+        return pts if polygon_area(pts) > 0.0 else pts[::-1]
+
+
+class Sphere(_Model):
+    """A ball of ``diameter`` with its centre at ``center`` (part coordinates): on or over the
+    part (a union with it), or alone on the table when the workpiece has no block/prism. Its
+    stem or holder is not modelled; holes and pockets do not cut it."""
+
+    type: Literal["sphere"]
+    center: Vec3
+    diameter: Positive
+
+
+class MachinedBy(_Model):
+    """The cutter that makes a feature in a machined-part series (design.md §9.3)."""
+
+    t: int = Field(ge=1, le=9999)
+
+
 class Hole(_Model):
     type: Literal["hole"]
     center: Vec2
     diameter: Positive
     depth: Positive
+    machined_by: MachinedBy | None = None
 
 
 class Pocket(_Model):
@@ -157,6 +240,7 @@ class Pocket(_Model):
     center: Vec2
     size: tuple[Positive, Positive]
     depth: Positive
+    machined_by: MachinedBy | None = None
 
 
 class Spigot(_Model):
@@ -164,6 +248,7 @@ class Spigot(_Model):
     center: Vec2
     diameter: Positive
     height: Positive
+    machined_by: MachinedBy | None = None
 
 
 class Boss(_Model):
@@ -171,9 +256,11 @@ class Boss(_Model):
     center: Vec2
     size: tuple[Positive, Positive]
     height: Positive
+    machined_by: MachinedBy | None = None
 
 
-Feature = Annotated[Block | Hole | Pocket | Spigot | Boss, Field(discriminator="type")]
+Feature = Annotated[Block | Prism | Hole | Pocket | Spigot | Boss | Sphere, Field(discriminator="type")]
+BASE_TYPES = ("block", "prism")          # the part's body; the other features go into/onto it
 
 
 class Workpiece(_Model):
@@ -182,16 +269,25 @@ class Workpiece(_Model):
 
     @model_validator(mode="after")
     def _one_block(self) -> Workpiece:
-        blocks = [f for f in self.features if f.type == "block"]
-        if len(blocks) > 1:
-            raise ValueError("features: at most one block per workpiece")
-        if not blocks and any(f.type in ("hole", "pocket", "spigot", "boss") for f in self.features):
-            raise ValueError("features: holes, pockets, spigots and bosses need a block to sit in/on")
+        bases = [f for f in self.features if f.type in BASE_TYPES]
+        if len(bases) > 1:
+            raise ValueError("features: at most one block or prism per workpiece")
+        if not bases and any(f.type in ("hole", "pocket", "spigot", "boss") for f in self.features):
+            raise ValueError("features: holes, pockets, spigots and bosses need a block or prism to sit in/on")
         return self
 
     @property
     def block(self) -> Block | None:
         return next((f for f in self.features if f.type == "block"), None)
+
+    @property
+    def base(self) -> Block | Prism | None:
+        """The part's body: its block or prism (None: spheres alone, or no part)."""
+        return next((f for f in self.features if isinstance(f, (Block, Prism))), None)   # BASE_TYPES
+
+    @property
+    def spheres(self) -> list[Sphere]:
+        return [f for f in self.features if f.type == "sphere"]
 
 
 class RingGauge(_Model):
@@ -225,6 +321,14 @@ class ToolNominal(_Model):
     radius: Positive | None = None
 
 
+class WearPerPart(_Model):
+    """How much the cutter loses per machined part (design.md §9.3): its true radius and length
+    get smaller by these amounts after each part."""
+
+    radius: float = Field(0.0, ge=0.0, le=1.0)
+    length: float = Field(0.0, ge=0.0, le=1.0)
+
+
 class Tool(_Model):
     """A true cutter: flat-end cylinder of ``radius``, tip ``length`` below the spindle nose."""
 
@@ -233,6 +337,7 @@ class Tool(_Model):
     length: Positive
     radius: Positive
     nominal: ToolNominal = Field(default_factory=ToolNominal)
+    wear_per_part: WearPerPart = Field(default_factory=WearPerPart)
 
     @property
     def nominal_length(self) -> float:
@@ -253,7 +358,7 @@ class RotaryAxis(_Model):
 
 
 class Scenario(_Model):
-    seed: int = 0
+    seed: int = Field(0, ge=0, le=2**63 - 1)          # numpy's generators take no negative seed
     machine: MachineConfig = Field(default_factory=MachineConfig)
     probe: ProbeConfig = Field(default_factory=ProbeConfig)
     workpiece: Workpiece | None = None
@@ -273,11 +378,11 @@ class Scenario(_Model):
             raise ValueError(f"machine.rotary_table.axis {table.axis!r} must be one of rotary_axes")
         head = self.machine.kinematics
         if head is not None:
-            for axis in head.axes:
-                if axis not in self.rotary_axes:
-                    raise ValueError(f"machine.kinematics.axes: {axis!r} must be one of rotary_axes")
-                if table is not None and table.axis == axis:
-                    raise ValueError(f"machine.kinematics.axes: {axis!r} is the rotary table's axis")
+            for head_axis in head.axes:
+                if head_axis not in self.rotary_axes:
+                    raise ValueError(f"machine.kinematics.axes: {head_axis!r} must be one of rotary_axes")
+                if table is not None and table.axis == head_axis:
+                    raise ValueError(f"machine.kinematics.axes: {head_axis!r} is the rotary table's axis")
         numbers = [tool.t for tool in self.tools]
         if len(set(numbers)) != len(numbers):
             raise ValueError("tools: tool numbers must be unique")
@@ -296,19 +401,26 @@ class Scenario(_Model):
         return self
 
     @property
+    def kind(self) -> str:
+        """The machine the scenario describes: "mill" (this model) or "lathe" (lathe_scenario)."""
+        return "mill"
+
+    @property
     def axes(self) -> tuple[str, ...]:
         return GEOMETRY_AXES + tuple(a for a in ROTARY_AXIS_NAMES if a in self.rotary_axes)
 
     def limits(self) -> dict[str, tuple[float, float]]:
-        out = {a: tuple(self.machine.limits[a]) for a in GEOMETRY_AXES}
-        out.update({a: tuple(ax.limits) for a, ax in self.rotary_axes.items()})
+        out = {a: self.machine.limits[a] for a in GEOMETRY_AXES}       # (lo, hi) tuples: no copies needed
+        out.update({a: ax.limits for a, ax in self.rotary_axes.items()})
         return out
 
     def start_position(self) -> dict[str, float]:
-        """Axes at load: ``start`` where given, else X/Y 0 clamped into the limits, Z at its top."""
+        """Axes at load: ``start`` where given, else Z and the spindle axis at their top (the tool
+        retracted), the others at 0 clamped into the limits."""
         position = {}
+        retracted = {"Z", self.machine.spindle_axis}
         for axis, (lo, hi) in self.limits().items():
-            default = hi if axis == "Z" else min(max(0.0, lo), hi)
+            default = hi if axis in retracted else min(max(0.0, lo), hi)
             position[axis] = float((self.start or {}).get(axis, default))
         return position
 
@@ -324,16 +436,34 @@ def _describe(error: ValidationError) -> str:
     return "invalid scenario: " + "; ".join(parts)
 
 
-def load_scenario(data: dict) -> Scenario:
-    """Validate a scenario dict; bad input raises ValueError naming the field(s)."""
+def load_scenario(data: dict) -> Scenario | LatheScenario:
+    """Validate a scenario dict; bad input raises ValueError naming the field(s).
+
+    ``machine.kind`` picks the model: "lathe" the simulated lathe's (lathe_scenario, turning.md
+    turning §10.2), else the milling machine's (unknown keys refused by each, the lathe's fields too)."""
     if not isinstance(data, dict):
         raise ValueError(f"invalid scenario: expected a JSON object, got {type(data).__name__}")
+    machine = data.get("machine")
+    if isinstance(machine, dict) and machine.get("kind") == "lathe":
+        return _validated(LatheScenario, data)
+    return _validated(Scenario, data)
+
+
+_ScenarioT = TypeVar("_ScenarioT", Scenario, LatheScenario)
+
+
+def _validated(model: type[_ScenarioT], data: dict) -> _ScenarioT:
     try:
-        return Scenario.model_validate(data)
+        return model.model_validate(data)
     except ValidationError as exc:
         raise ValueError(_describe(exc)) from None
 
 
 def demo_scenario() -> Scenario:
     """The built-in demo: a rotated block with hole, pocket, spigot and boss, gauges, two cutters."""
-    return load_scenario(json.loads(DEMO_SCENARIO_PATH.read_text(encoding="utf-8")))
+    return _validated(Scenario, json.loads(DEMO_SCENARIO_PATH.read_text(encoding="utf-8")))   # a milling one
+
+
+def lathe_demo_scenario() -> LatheScenario:
+    """The lathe demo (README): turning.md §10.2's example truth (1-B, 2-A, 4-A, 5-C) on one lathe."""
+    return _validated(LatheScenario, json.loads(LATHE_DEMO_SCENARIO_PATH.read_text(encoding="utf-8")))

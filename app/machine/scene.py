@@ -2,7 +2,12 @@
 
 Composition: ``sdf = min over bodies of max(sdf_P, -sdf_N1, -sdf_N2, ...)``: a body is one
 positive convex primitive minus convex cut-outs (block minus holes/pockets, ring minus bore);
-spigots, bosses, gauges are further bodies (union).
+spigots, bosses, spheres, gauges are further bodies (union). A prism part (design.md §9.8) is
+the union of convex prisms: its polygon (normalised counter-clockwise) is cut into convex
+pieces (ear clipping, then Hertel–Mehlhorn merging of the triangles while the union stays
+convex), each piece one body with the part's cut-outs. The distance to a union is the minimum
+of the distances, so the composed set {sdf <= r} (r > 0) is exact whatever the pieces; inside
+the part the composed value is a bound (pieces meet at inner diagonals), used only for its sign.
 
 Contact of a ball of radius r swept along c(s) = c0 + s·d happens where sdf(c(s)) <= r. For
 a body that set is ``{sdf_P <= r} minus ∪{sdf_N < -r}``. Each primitive's signed distance
@@ -11,10 +16,12 @@ root-found (golden-section bracket, then brentq to 1e-13 mm): nothing is stepped
 and parallel moves cost the same as head-on ones.
 
 Exactness (honest list):
-- exact: every plane face at any angle (block faces of a rotated/tilted block, hole and
-  pocket bottoms, boss faces), cylinder walls from inside (holes, ring bore) and outside
-  (spigots, ring, tool probe), the block's own edges and corners (exact box SDF), concave
-  junctions (hole bottom edge, spigot foot: union of exact sets is exact).
+- exact: every plane face at any angle (block faces of a rotated/tilted block, prism walls,
+  hole and pocket bottoms, boss faces), cylinder walls from inside (holes, ring bore) and
+  outside (spigots, ring, tool probe), spheres, the block's and the prism's own edges and
+  corners (exact box SDF, exact extruded convex-polygon SDF: vertical edges at any corner
+  angle, top and bottom rims), a non-convex prism's inside corners and concave junctions
+  (hole bottom edge, spigot foot, sphere on the part: a union of exact sets is exact).
 - a bound only: convex edges made by subtraction (the rim of a hole or pocket, the ring's
   bore rim). There the composed set is the sharp offset instead of the rounded one, so a
   ball reaching over a rim from above touches up to (√2 − 1)·r earlier than the true torus
@@ -29,7 +36,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import brentq
 
-from .physics import rpy_matrix
+from .physics import SPINDLE_MOUNTS, rpy_matrix
+from .polygon import convex_pieces
 
 ROOT_XTOL = 1e-13          # mm, brentq tolerance on the path parameter
 _GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
@@ -48,6 +56,19 @@ class Primitive:
 
     def local_sdf(self, x: float, y: float, z: float) -> float:  # pragma: no cover - abstract
         raise NotImplementedError
+
+    @property
+    def bound(self) -> float:      # pragma: no cover - abstract
+        """Radius about ``centre`` of a sphere holding the solid."""
+        raise NotImplementedError
+
+    def out_of_reach(self, c0: np.ndarray, d: np.ndarray, length: float, level: float) -> bool:
+        """True when no point of the path c0 + s·d, s in [0, length], comes within ``level`` of
+        the solid (the bounding sphere proves it): the exact search can be skipped."""
+        rel = self.centre - c0
+        s = min(max(float(rel @ d), 0.0), length)
+        gap = float(np.linalg.norm(rel - s * d))
+        return gap > self.bound + max(level, 0.0) + 1e-9
 
     def sdf(self, p_in_mcs) -> float:
         q = self.to_local(p_in_mcs)
@@ -74,6 +95,10 @@ class Box(Primitive):
         outside = math.sqrt(max(qx, 0.0) ** 2 + max(qy, 0.0) ** 2 + max(qz, 0.0) ** 2)
         return outside + min(max(qx, qy, qz), 0.0)
 
+    @property
+    def bound(self) -> float:
+        return math.sqrt(self.hx ** 2 + self.hy ** 2 + self.hz ** 2)
+
 
 class Cylinder(Primitive):
     """Capped cylinder along the local z axis."""
@@ -88,6 +113,79 @@ class Cylinder(Primitive):
         dz = abs(z) - self.hz
         return min(max(dr, dz), 0.0) + math.hypot(max(dr, 0.0), max(dz, 0.0))
 
+    @property
+    def bound(self) -> float:
+        return math.hypot(self.radius, self.hz)
+
+    def out_of_reach(self, c0: np.ndarray, d: np.ndarray, length: float, level: float) -> bool:
+        """The cylinder lies in the capsule of its axis segment and radius (cut-outs are long)."""
+        axis = self.rotation[:, 2]
+        gap = _segment_distance(c0, d, length, self.centre - self.hz * axis, axis, 2.0 * self.hz)
+        return gap > self.radius + max(level, 0.0) + 1e-9
+
+
+class ConvexPrism(Primitive):
+    """A convex polygon (local x/y, counter-clockwise) extruded over local z in [−hz, hz].
+
+    Exact SDF: the 2D convex polygon's signed distance w (outside: distance to the nearest
+    edge segment; inside: −distance to the nearest edge line) extruded like a box:
+    ``min(max(w, dz), 0) + |(max(w, 0), max(dz, 0))|``, dz = |z| − hz. Convex, 1-Lipschitz.
+    """
+
+    def __init__(self, rotation, centre, polygon, half_height: float) -> None:
+        super().__init__(rotation, centre)
+        pts = [(float(x), float(y)) for x, y in polygon]
+        self.polygon = pts
+        self.hz = float(half_height)
+        edges = []
+        for i, (ax, ay) in enumerate(pts):
+            bx, by = pts[(i + 1) % len(pts)]
+            ex, ey = bx - ax, by - ay
+            length = math.hypot(ex, ey)
+            edges.append((ax, ay, ex, ey, 1.0 / (length * length), ey / length, -ex / length))
+        self._edges = tuple(edges)
+
+    def distance_2d(self, x: float, y: float) -> float:
+        """Signed distance of (x, y) to the polygon (negative inside)."""
+        best_sq = math.inf
+        plane = -math.inf
+        for ax, ay, ex, ey, inv_sq, nx, ny in self._edges:
+            px, py = x - ax, y - ay
+            h = nx * px + ny * py                       # signed distance to the edge line (outward +)
+            if h > plane:
+                plane = h
+            t = (px * ex + py * ey) * inv_sq
+            t = 0.0 if t < 0.0 else (1.0 if t > 1.0 else t)
+            qx, qy = px - t * ex, py - t * ey
+            sq = qx * qx + qy * qy
+            if sq < best_sq:
+                best_sq = sq
+        return plane if plane <= 0.0 else math.sqrt(best_sq)
+
+    def local_sdf(self, x: float, y: float, z: float) -> float:
+        w = self.distance_2d(x, y)
+        dz = abs(z) - self.hz
+        return min(max(w, dz), 0.0) + math.hypot(max(w, 0.0), max(dz, 0.0))
+
+    @property
+    def bound(self) -> float:
+        return math.hypot(max(math.hypot(x, y) for x, y in self.polygon), self.hz)
+
+
+class Ball(Primitive):
+    """A sphere of ``radius`` about its centre (exact SDF)."""
+
+    def __init__(self, centre, radius: float) -> None:
+        super().__init__(np.eye(3), centre)
+        self.radius = float(radius)
+
+    def local_sdf(self, x: float, y: float, z: float) -> float:
+        return math.sqrt(x * x + y * y + z * z) - self.radius
+
+    @property
+    def bound(self) -> float:
+        return self.radius
+
 
 @dataclass
 class Body:
@@ -97,6 +195,23 @@ class Body:
 
     def sdf(self, p) -> float:
         return max([self.solid.sdf(p)] + [-c.sdf(p) for c in self.cutouts])
+
+
+def _segment_distance(p0, u, length_u: float, q0, v, length_v: float) -> float:
+    """Distance between the segments p0 + s·u (s in [0, length_u]) and q0 + t·v (t in [0,
+    length_v]); u, v unit vectors (the closest points by clamping, Ericson §5.1.9)."""
+    r = p0 - q0
+    b = float(u @ v)
+    c = float(u @ r)
+    f = float(v @ r)
+    denom = 1.0 - b * b
+    s = min(max((b * f - c) / denom, 0.0), length_u) if denom > 1e-12 else 0.0
+    t = b * s + f
+    if t < 0.0:
+        t, s = 0.0, min(max(-c, 0.0), length_u)
+    elif t > length_v:
+        t, s = length_v, min(max(b * length_v - c, 0.0), length_u)
+    return float(np.linalg.norm(p0 + s * u - (q0 + t * v)))
 
 
 def _sublevel_interval(g, level: float, length: float) -> tuple[float, float] | None:
@@ -181,11 +296,15 @@ class Scene:
         d = np.asarray(direction, dtype=float)
         pieces: list[tuple[float, float]] = []
         for body in self.bodies:
+            if body.solid.out_of_reach(c0, d, max_distance, radius):
+                continue
             main = _sublevel_interval(body.solid.along(c0, d), radius, max_distance)
             if main is None:
                 continue
             body_pieces = [main]
             for cutout in body.cutouts:
+                if cutout.out_of_reach(c0, d, max_distance, -radius):
+                    continue
                 cut = _sublevel_interval(cutout.along(c0, d), -radius, max_distance)
                 if cut is None:
                     continue
@@ -254,27 +373,63 @@ def _cut_from_top(depth: float, block_height: float) -> tuple[float, float]:
     return (_EXTEND + bottom) / 2.0, (_EXTEND - bottom) / 2.0
 
 
+def spindle_mount(scenario) -> np.ndarray:
+    """Probe frame -> MCS at SPOS 0 (physics.SPINDLE_MOUNTS): local z = the spindle axis."""
+    return SPINDLE_MOUNTS[scenario.machine.spindle_axis]
+
+
+def _base_solids(base, rot, place) -> list[Primitive]:
+    """The part's body (block or prism) as convex primitives in MCS."""
+    if base.type == "block":
+        lx, ly, lz = base.size
+        return [Box(rot, place([lx / 2, ly / 2, -lz / 2]), [lx / 2, ly / 2, lz / 2])]
+    centre = place([0.0, 0.0, -base.height / 2])
+    return [ConvexPrism(rot, centre, piece, base.height / 2) for piece in convex_pieces(base.polygon)]
+
+
+def _base_height(base) -> float:
+    return base.size[2] if base.type == "block" else base.height
+
+
+def _vertical(mount) -> bool:
+    return mount is None or np.array_equal(np.asarray(mount, dtype=float), np.eye(3))
+
+
+def _axial_cylinder(mount: np.ndarray, face_centre, radius: float, length: float) -> Cylinder:
+    """A cylinder whose axis is the spindle axis (``mount``·ẑ): its face at ``face_centre`` (the
+    face towards the spindle), reaching ``length`` away from the spindle."""
+    face = np.asarray(face_centre, dtype=float)
+    if _vertical(mount):                                  # the vertical gauge, as in wave 1
+        return Cylinder(np.eye(3), [face[0], face[1], face[2] - length / 2], radius, length / 2)
+    return Cylinder(mount, face - mount[:, 2] * (length / 2), radius, length / 2)
+
+
 def build_scene(scenario, table_angle: float = 0.0) -> Scene:
-    """The scenario's true solids (design.md §4 field meanings) as a Scene in MCS."""
+    """The scenario's true solids (design.md §4 field meanings) as a Scene in MCS.
+
+    Gauges (ring, tool probe) stand along the spindle axis: their ``center`` is the centre of
+    the face towards the spindle (the top face on a vertical spindle), their height reaches away
+    from it. Spheres are bodies of their own (no cut-out cuts them); without a block or prism the
+    workpiece is its spheres alone.
+    """
     bodies: list[Body] = []
-    identity = np.eye(3)
     wp = scenario.workpiece
-    if wp is not None and wp.block is not None:
+    if wp is not None and (wp.base is not None or wp.spheres):
         rot, trans = workpiece_pose(scenario, table_angle)
 
         def place(p_part) -> np.ndarray:
             return rot @ np.asarray(p_part, dtype=float) + trans
 
-        lx, ly, lz = wp.block.size
-        block = Box(rot, place([lx / 2, ly / 2, -lz / 2]), [lx / 2, ly / 2, lz / 2])
+        base = wp.base
         cutouts: list[Primitive] = []
         extras: list[Body] = []
+        height = _base_height(base) if base is not None else 0.0
         for f in wp.features:
             if f.type == "hole":
-                mid, half = _cut_from_top(f.depth, lz)
+                mid, half = _cut_from_top(f.depth, height)
                 cutouts.append(Cylinder(rot, place([f.center[0], f.center[1], mid]), f.diameter / 2, half))
             elif f.type == "pocket":
-                mid, half = _cut_from_top(f.depth, lz)
+                mid, half = _cut_from_top(f.depth, height)
                 cutouts.append(Box(rot, place([f.center[0], f.center[1], mid]),
                                    [f.size[0] / 2, f.size[1] / 2, half]))
             elif f.type == "spigot":
@@ -283,34 +438,48 @@ def build_scene(scenario, table_angle: float = 0.0) -> Scene:
             elif f.type == "boss":
                 extras.append(Body("part", Box(rot, place([f.center[0], f.center[1], f.height / 2]),
                                                [f.size[0] / 2, f.size[1] / 2, f.height / 2])))
-        bodies.append(Body("part", block, cutouts))
+            elif f.type == "sphere":
+                extras.append(Body("part", Ball(place(f.center), f.diameter / 2)))
+        if base is not None:
+            bodies.extend(Body("part", solid, cutouts) for solid in _base_solids(base, rot, place))
         bodies.extend(extras)
+    mount = spindle_mount(scenario)
     ring = scenario.ring_gauge
     if ring is not None:
-        cx, cy, cz = ring.center
-        outer = Cylinder(identity, [cx, cy, cz - ring.height / 2], ring.outer_diameter / 2, ring.height / 2)
-        bore = Cylinder(identity, [cx, cy, cz - ring.height / 2], ring.diameter / 2, _EXTEND)
+        outer = _axial_cylinder(mount, ring.center, ring.outer_diameter / 2, ring.height)
+        bore = Cylinder(outer.rotation, outer.centre, ring.diameter / 2, _EXTEND)
         bodies.append(Body("ring_gauge", outer, [bore]))
     tp = scenario.tool_probe
     if tp is not None:
-        bodies.append(Body("tool_probe", tool_probe_cylinder(tp)))
+        bodies.append(Body("tool_probe", tool_probe_cylinder(tp, mount=mount)))
     return Scene(bodies)
 
 
 def outline(scenario, table_angle: float = 0.0) -> dict:
-    """The true solids for the machine view (JSON-ready, MCS): block corners, circles, rects."""
-    out: dict = {"block": None, "circles": [], "rects": []}
+    """The true solids for the machine view (JSON-ready, MCS): block corners, circles, rects,
+    the prism's polygon (``prism``: ``top``/``bottom`` vertices counter-clockwise seen from the
+    part's +z, ``axis`` = the part's z axis, ``height``) and the spheres (``spheres``: ``center``,
+    ``diameter``). Circles carry their cylinder ``axis`` (the part's z, or the spindle axis for
+    the gauges)."""
+    out: dict = {"block": None, "prism": None, "circles": [], "rects": [], "spheres": []}
     wp = scenario.workpiece
-    if wp is not None and wp.block is not None:
+    if wp is not None and (wp.base is not None or wp.spheres):
         rot, trans = workpiece_pose(scenario, table_angle)
 
         def place(x: float, y: float, z: float) -> list[float]:
             return [float(v) for v in rot @ np.array([x, y, z]) + trans]
 
         axis = [float(v) for v in rot[:, 2]]          # the part's z axis
-        lx, ly, lz = wp.block.size
-        out["block"] = {"corners": [place(x, y, z) for z in (0.0, -lz) for x, y in
-                                    ((0, 0), (lx, 0), (lx, ly), (0, ly))]}
+        base = wp.base
+        if base is not None and base.type == "block":
+            lx, ly, lz = base.size
+            out["block"] = {"corners": [place(x, y, z) for z in (0.0, -lz) for x, y in
+                                        ((0, 0), (lx, 0), (lx, ly), (0, ly))]}
+        elif base is not None:
+            polygon = base.ccw_polygon
+            out["prism"] = {"kind": "prism", "top": [place(x, y, 0.0) for x, y in polygon],
+                            "bottom": [place(x, y, -base.height) for x, y in polygon],
+                            "axis": axis, "height": float(base.height)}
         for f in wp.features:
             if f.type in ("hole", "spigot"):
                 top = 0.0 if f.type == "hole" else f.height
@@ -323,7 +492,10 @@ def outline(scenario, table_angle: float = 0.0) -> dict:
                 cx, cy = f.center
                 out["rects"].append({"kind": f.type, "corners": [
                     place(cx + sx * hx, cy + sy * hy, top) for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))]})
-    up = [0.0, 0.0, 1.0]
+            elif f.type == "sphere":
+                out["spheres"].append({"kind": "sphere", "center": place(*f.center),
+                                       "diameter": float(f.diameter)})
+    up = [float(v) for v in spindle_mount(scenario)[:, 2]]
     if scenario.ring_gauge is not None:
         ring = scenario.ring_gauge
         for kind, dia in (("ring_bore", ring.diameter), ("ring_outer", ring.outer_diameter)):
@@ -336,9 +508,15 @@ def outline(scenario, table_angle: float = 0.0) -> dict:
     return out
 
 
-def tool_probe_cylinder(tool_probe, grow_radius: float = 0.0, grow_down: float = 0.0) -> Cylinder:
-    """The tool probe cylinder, optionally grown (Minkowski sum with a vertical cutter)."""
-    cx, cy, cz = tool_probe.center
-    bottom = cz - tool_probe.height - grow_down
-    return Cylinder(np.eye(3), [cx, cy, (cz + bottom) / 2], tool_probe.disc_diameter / 2 + grow_radius,
-                    (cz - bottom) / 2)
+def tool_probe_cylinder(tool_probe, grow_radius: float = 0.0, grow_down: float = 0.0, mount=None) -> Cylinder:
+    """The tool probe cylinder, optionally grown (Minkowski sum with a cutter along its axis).
+
+    Its axis is the spindle axis (``mount``·ẑ, default vertical); ``center`` is its face towards
+    the spindle, ``grow_down`` extends it away from the spindle."""
+    if _vertical(mount):
+        cx, cy, cz = tool_probe.center
+        bottom = cz - tool_probe.height - grow_down
+        return Cylinder(np.eye(3), [cx, cy, (cz + bottom) / 2], tool_probe.disc_diameter / 2 + grow_radius,
+                        (cz - bottom) / 2)
+    return _axial_cylinder(np.asarray(mount, dtype=float), tool_probe.center,
+                           tool_probe.disc_diameter / 2 + grow_radius, tool_probe.height + grow_down)

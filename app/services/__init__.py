@@ -13,6 +13,8 @@ from db import Database
 
 from .log import LogService
 from .machine_service import MachineService
+from .memories import MemoryService
+from .nc import NcService, ProgramService
 from .offsets import OffsetService
 from .plc import PlcSimulator
 from .probes import ProbeService, ToolProbeService
@@ -30,8 +32,12 @@ class Services:
     probes: ProbeService
     tool_probes: ToolProbeService
     log: LogService
+    memories: MemoryService | None = None
     workflow: WorkflowService | None = None
     plc: PlcSimulator | None = None
+    nc: NcService | None = None
+    programs: ProgramService | None = None
 
 
-__all__ = ["LogService", "MachineService", "OffsetService", "ProbeService", "Services", "ToolProbeService", "SettingsService", "ToolService"]
+__all__ = ["LogService", "MachineService", "MemoryService", "NcService", "OffsetService", "ProbeService", "ProgramService",
+           "Services", "ToolProbeService", "SettingsService", "ToolService"]

@@ -1,37 +1,63 @@
 """The machine as the HMI drives it: frame chain, activation, WCS<->MCS, motion, tool change, scenario.
 
-Owns the one ``Machine`` (the simulator, later a real controller). WCS positions are those of
+Owns the one ``Machine`` (the simulator or a real controller, app.machine.registry) and calls
+only what the ``Machine`` Protocol offers; the optional interfaces (``SwivelHead``,
+``SimulatorControl``) are asked for with ``isinstance`` first: a scenario load or the machine
+view on a controller without them is a 409 ``not_simulated``. Every named offset and tool the
+HMI stores is written to the machine too (``write_offset``/``write_tool``: at start-up, after a
+scenario load and after each write), so that the NC holds what the HMI stored. WCS positions are those of
 the tool tip: ``tip = axes - L * infeed_unit`` with L the NC's offset length (tool length +
 wear) along the infeed axis of the measuring plane, and ``tip_mcs = wcs2bcs(p_wcs)`` (BCS = MCS).
 The active settable offset and the tool in the spindle are persisted in the db state.
+
+On a lathe (a machine whose ``kind`` is "lathe", turning.md §10.2) the tip is
+``P = F − (L1·x̂ + L2·ẑ)`` with the NC's lengths of the active tool (``engine.coords.LatheToolTip``),
+WCS X is shown and read as a diameter with diameter programming (DIAMON), the plane is G18,
+and ``GET /api/machine`` adds ``"kind": "lathe"``. Loading a scenario of the other kind
+builds the other machine (``rebuild``, the registry's factory under the same name) and resets
+the stored data: tool table, offsets and records of a milling machine mean nothing on a lathe.
 With a swivel head turned out of +Z the length goes along the machine's actual tool axis
 (``status().tool_axis``, TRAORI-like), so that WCS tip positions stay right
-(``app.workflow.executor.length_axis``, which owns the tip <-> axes conversion).
+(``engine.coords``, which owns the tip <-> axes conversion).
 """
 
 from __future__ import annotations
 
 import math
 import threading
+import time
 from collections.abc import Callable, Mapping
 from contextlib import contextmanager
+from functools import partial
+from typing import overload
 
 import numpy as np
 
-from app.errors import AlarmError, BusyError, InvalidInput, NotFoundError
-from app.machine.protocol import ActiveFrame, Alarm, Machine, MachineAlarm, MachineBusy, MoveResult
+from app.errors import AlarmError, BusyError, ConflictError, InvalidInput, NotFoundError
+from app.machine.lathe_scenario import LatheScenario
+from app.machine.protocol import (
+    ActiveFrame,
+    Alarm,
+    Machine,
+    MachineAlarm,
+    MachineBusy,
+    MoveResult,
+    SimulatorControl,
+    SwivelHead,
+)
 from app.machine.scenario import Scenario
-from app.workflow.executor import StepExecutor
+from app.records import PROBE_TOOL_TYPE
 from db import Database
-from engine.frames import GEOMETRY_AXES, Frame, FrameChain
+from engine.alarms import all_alarms
+from engine.alarms import by_number as alarm_by_number
+from engine.coords import GEOMETRY_AXES, LatheToolTip, ToolTip, length_axis
+from engine.frames import G500, Frame, FrameChain, chain_of, is_basic
 from engine.planes import plane as plane_by_name
 
+from . import lathe_data
 from .settings import SettingsService
 
 CHANNEL = "CHAN1"
-G500 = "G500"
-SETFRAME = "BASIC_REF"             # the system frame outside the basic frames
-PROBE_TOOL_TYPE = 710            # 3D probe, multidirectional (spec §10: 710/1xy)
 MAX_TRAVEL = 10_000.0            # mm; a bigger single move is a typo
 MAX_FEED = 50_000.0              # mm/min
 STATE_ACTIVE_OFFSET = "active_offset"
@@ -44,40 +70,38 @@ def _finite(value, field: str) -> float:
     return float(value)
 
 
-def basic_frame_names(names) -> tuple[str, ...]:
-    """BASIC_0, BASIC_1, … in chain order (BASIC_REF is the SETFRAME, outside all of them)."""
-    return tuple(sorted((n for n in names if n.startswith("BASIC_") and n != SETFRAME),
-                        key=lambda n: int(n.split("_")[1])))
-
-
-def frame_chain(offsets: Mapping[str, Frame], active: str) -> FrameChain:
-    """WCS->BCS = BASIC_REF ∘ BASIC_0 ∘ BASIC_1 ∘ … ∘ ``active`` (identity under G500)."""
-    return FrameChain(setframe=offsets.get(SETFRAME, Frame.identity()),
-                      basic=tuple(offsets[n] for n in basic_frame_names(offsets)),
-                      settable=Frame.identity() if active == G500 else offsets[active])
-
-
 def alarm_dict(alarm: Alarm) -> dict:
-    return {"code": alarm.code, "text": alarm.text}
+    """An alarm with the manual's remedy (seed 001 turning §11, "说明，消除"), "" where the catalogue has none."""
+    definition = alarm_by_number(alarm.code)
+    broken = definition is not None and definition.resettable != alarm.resettable
+    if broken:      # 61302 twice: the broken stylus is the one Reset cannot clear
+        definition = next((a for a in all_alarms() if a.number == alarm.code and a.resettable == alarm.resettable),
+                          definition)
+    return {"code": alarm.code, "text": alarm.text, "remedy": definition.remedy if definition else ""}
 
 
 class MachineService:
     """Thin, thread-safe orchestration around a ``Machine``; every method returns plain data."""
 
-    def __init__(self, db: Database, machine: Machine, scenario: Scenario, settings: SettingsService,
-                 machine_factory: Callable[[Scenario], Machine] | None = None):
+    def __init__(self, db: Database, machine: Machine, scenario: Scenario | LatheScenario, settings: SettingsService,
+                 rebuild: Callable[[Scenario | LatheScenario], Machine] | None = None):
         self._db = db
+        self._rebuild = rebuild              # builds the machine of a scenario of the other kind
         self._machine = machine
         self._scenario = scenario
         self._settings = settings
         self._lock = threading.RLock()       # guards chain/tool bookkeeping, not the motion itself
         self._chain = FrameChain()
         self._active_offset = G500
-        self.panel = PanelState()
+        self._hold = HoldToRun(machine)
+        self._frames: tuple[int, dict[str, Frame]] | None = None
+        self._discard_listeners: list[Callable[[str], None]] = []
+        self.mode_source: Callable[[], str | None] | None = None   # the NC channel's mode (MDA/AUTO)
         with db.unit(readonly=True) as unit:
             active = unit.get_state(STATE_ACTIVE_OFFSET, G500)
             tool = unit.get_state(STATE_TOOL, None)
         self._seed_data(reset=False)
+        self._push_nc_data()
         self.activate(active if self._is_settable(active) else G500)
         self._restore_tool(tool)
 
@@ -87,7 +111,7 @@ class MachineService:
         return self._machine
 
     @property
-    def scenario(self) -> Scenario:
+    def scenario(self) -> Scenario | LatheScenario:
         return self._scenario
 
     @property
@@ -106,8 +130,17 @@ class MachineService:
     def chain(self) -> FrameChain:
         return self._chain
 
+    @property
+    def is_lathe(self) -> bool:
+        """The machine is a lathe (turning.md §10.2): X radius, DIAMON, the lathe tasks."""
+        return getattr(self._machine, "kind", "mill") == "lathe"
+
+    @property
+    def diameter_programming(self) -> bool:
+        return self.is_lathe and bool(getattr(self._machine, "diameter_programming", False))
+
     def plane(self):
-        return plane_by_name(self._settings.get().plane)
+        return plane_by_name("G18" if self.is_lathe else self._settings.get().plane)
 
     def status(self) -> dict:
         """The ``GET /api/machine`` body (design.md §4) plus channel, tool length, program state."""
@@ -115,7 +148,7 @@ class MachineService:
         alarms = [alarm_dict(a) for a in st.alarms]
         program_state = "active" if st.busy else ("interrupted" if alarms else "reset")
         return {
-            "mode": st.mode,
+            "mode": (self.mode_source() if self.mode_source else None) or st.mode,
             "channel": CHANNEL,
             "mcs": {a: float(v) for a, v in st.mcs.items()},
             "wcs": self.wcs_from_mcs(st.mcs, st.tool_length),
@@ -130,36 +163,59 @@ class MachineService:
             "program_state": program_state,
             "tool_axis": [float(v) for v in getattr(st, "tool_axis", (0.0, 0.0, 1.0))],
             "swivel": self.has_swivel(),
+            "controller": self._machine.controller,
+            **(self._lathe_status(st) if self.is_lathe else {}),
         }
 
-    # --- swivel head (CYCLE800-like re-alignment, spec §6.2) --------------------------------
+    def _lathe_status(self, st) -> dict:
+        l1, l2 = getattr(st, "tool_lengths", (0.0, 0.0))
+        return {"kind": "lathe", "plane": "G18", "diameter_programming": self.diameter_programming,
+                "x_unit": "diameter" if self.diameter_programming else "radius",
+                "tool_lengths": {"L1": float(l1), "L2": float(l2)}}
+
+    # --- swivel head (CYCLE800-like re-alignment, jog-measuring §6.2) --------------------------------
+    def _swivel_head(self) -> SwivelHead | None:
+        return self._machine if isinstance(self._machine, SwivelHead) else None
+
     def has_swivel(self) -> bool:
-        return bool(getattr(self._machine, "has_swivel", lambda: False)())
+        head = self._swivel_head()
+        return head is not None and bool(head.has_swivel())
 
     def retract_tool_axis(self, distance: float | None = None) -> dict:
-        """Retract up along the tool axis (to the limits by default) before a swivel (spec §11 Q9)."""
+        """Retract up along the tool axis (to the limits by default) before a swivel (jog-measuring §11 Q9)."""
         if distance is not None:
             distance = _finite(distance, "distance")
-        return self._run(lambda: self._machine.retract_tool_axis(distance))
+        head = self._swivel_head()
+        if head is None:
+            raise InvalidInput("this machine has no swivel kinematics", field="retract")
+        return self._run(lambda: head.retract_tool_axis(distance))
 
     def swivel_to_wcs(self) -> dict:
         """Swivel the head so that the tool axis is parallel to the active WCS's infeed axis."""
-        if not self.has_swivel():
+        head = self._swivel_head()
+        if head is None or not self.has_swivel():
             raise InvalidInput("this machine has no swivel kinematics", field="realign")
         rotation = self._chain.wcs2bcs.as_matrix()[:3, :3]
         infeed = np.asarray(self.plane().infeed_unit, dtype=float)
-        return self._run(lambda: self._machine.swivel_to_wcs(rotation, infeed))
+        return self._run(lambda: head.swivel_to_wcs(rotation, infeed))
 
     # --- coordinates ----------------------------------------------------------------------
-    def _tip(self, tool_length: float | None) -> StepExecutor:
-        """Tool tip <-> axis positions in the active chain (the executor owns the conversion)."""
+    def _tip(self, tool_length: float | None) -> ToolTip | LatheToolTip:
+        """Tool tip <-> axis positions in the active chain (``engine.coords``)."""
+        st = self._machine.status()
+        if self.is_lathe:
+            l1, l2 = getattr(st, "tool_lengths", (0.0, 0.0))
+            return LatheToolTip(self._chain.wcs2bcs, float(l1), float(l2))
         if tool_length is None:
-            tool_length = self._machine.status().tool_length
-        return StepExecutor(self._machine, self._chain.wcs2bcs, tool_length, self.plane().infeed_unit)
+            tool_length = st.tool_length
+        axis = length_axis(getattr(st, "tool_axis", None), self.plane().infeed_unit)
+        return ToolTip(self._chain.wcs2bcs, float(tool_length), axis)
 
     def wcs_from_mcs(self, mcs: Mapping[str, float], tool_length: float | None = None) -> dict[str, float]:
-        p_wcs = self._tip(tool_length).tip_in_wcs([float(mcs[a]) for a in GEOMETRY_AXES])
+        p_wcs = self._tip(tool_length).tip_in_wcs([float(mcs.get(a, 0.0)) for a in GEOMETRY_AXES])
         out = {a: float(v) for a, v in zip(GEOMETRY_AXES, p_wcs, strict=True)}
+        if self.diameter_programming:
+            out["X"] *= 2.0                      # DIAMON: WCS X as a diameter (turning.md §0.3)
         for axis in self.rotary_axes:
             if axis in mcs:
                 out[axis] = float(mcs[axis]) - self._chain.wcs2bcs.rotary_offset(axis)
@@ -167,6 +223,8 @@ class MachineService:
 
     def mcs_from_wcs(self, wcs: Mapping[str, float], tool_length: float | None = None) -> dict[str, float]:
         """Full WCS point (X, Y, Z; rotary optional) -> axis positions of the tool reference point."""
+        if self.diameter_programming:
+            wcs = {**wcs, "X": float(wcs["X"]) / 2.0}
         axes_xyz = self._tip(tool_length).axes_for_tip([float(wcs[a]) for a in GEOMETRY_AXES], "WCS")
         out = {a: float(v) for a, v in zip(GEOMETRY_AXES, axes_xyz, strict=True)}
         for axis in self.rotary_axes:
@@ -180,6 +238,10 @@ class MachineService:
             raise InvalidInput(f"{field}: unknown axis {axis!r}; axes are {', '.join(self.axes)}", field=field)
         return axis.upper()
 
+    @overload
+    def _check_feed(self, feed: None, field: str = ...) -> None: ...
+    @overload
+    def _check_feed(self, feed: float, field: str = ...) -> float: ...
     def _check_feed(self, feed, field: str = "feed") -> float | None:
         if feed is None:
             return None
@@ -223,18 +285,37 @@ class MachineService:
         return self._run(lambda: self._machine.jog(axis, distance, feed))
 
     def jog_continuous(self, axis: str, direction: int, feed: float | None = None) -> dict:
+        """Hold-to-run (design.md §9.1): starts the jog, or renews the running one of the same
+        axis and direction, for at most ``HOLD_S``; without a renewal the axis stops."""
         axis = self._check_axis(axis)
         if direction not in (-1, 1):
             raise InvalidInput("direction: must be -1 or +1", field="direction")
         feed = self._check_feed(feed)
-        self._ensure_idle()
-        with self._machine_errors():
-            self._machine.jog_continuous(axis, direction, feed)
+        if not self._hold.renew(axis, direction):
+            self._ensure_idle()
+            with self._machine_errors():
+                self._hold.start(axis, direction, feed)
         return self.status()
 
     def stop(self) -> dict:
+        self._hold.release()
         self._machine.stop()
         return self.status()
+
+    def release_jog(self) -> None:
+        """Another motion takes over the axes: the hold-to-run watchdog lets go of them."""
+        self._hold.release()
+
+    def stop_jog(self) -> dict:
+        """The operator let go of a jog key: stop the continuous jog if one is held, nothing else
+        (a late key-up must not stop the measurement NC Start has started since)."""
+        if self._hold.release():
+            self._machine.stop()
+        return self.status()
+
+    def close(self) -> None:
+        self._hold.close()
+        self._machine.close()
 
     def goto_target(self, target: Mapping[str, float | None], coords: str = "WCS") -> dict[str, float]:
         """Validated MCS target of a goto; axes not given keep their current position in ``coords``."""
@@ -291,6 +372,16 @@ class MachineService:
         self._machine.reset()
         return self.status()
 
+    def spindle_position(self, angle: float) -> dict:
+        """SPOS (deg, 0..360): on a lathe the clamped workpiece turns with the main spindle."""
+        angle = _finite(angle, "angle")
+        if not 0.0 <= angle <= 360.0:
+            raise InvalidInput("angle: SPOS 0..360 degrees", field="angle")
+        self._ensure_idle()
+        with self._machine_errors():
+            self._machine.spindle_position(angle)
+        return self.status()
+
     def set_override(self, percent: float) -> dict:
         percent = _finite(percent, "feed")
         if not 0 <= percent <= 120:
@@ -328,23 +419,41 @@ class MachineService:
         return float(tool_data["length"]) + float(tool_data.get("wear", {}).get("length", 0.0))
 
     def change_tool(self, tool) -> dict:
+        """Tool change. The database records the new tool first and is put back if the machine
+        refuses: machine and database never disagree about the spindle (design.md §9.1)."""
         t = self.resolve_tool(tool)
         length = 0.0
+        with self._db.unit(readonly=True) as unit:
+            data = unit.get_tool(t) if t is not None else None
+            previous = unit.get_state(STATE_TOOL, None)
         if t is not None:
-            with self._db.unit(readonly=True) as unit:
-                data = unit.get_tool(t)
             if data is None:
                 raise NotFoundError(f"T{t} is not in the tool table", field="tool", code="unknown_tool")
             length = self.offset_length(data)
         self._ensure_idle()
+        with self._db.unit() as unit:
+            unit.set_state(STATE_TOOL, t)
         try:
             with self._machine_errors():
                 self._machine.change_tool(t, length)
-        except ValueError as exc:      # the tool table knows it, the machine's magazine does not
-            raise InvalidInput(f"tool: {exc}", field="tool") from None
-        with self._db.unit() as unit:
-            unit.set_state(STATE_TOOL, t)
+        except BaseException as exc:
+            with self._db.unit() as unit:
+                unit.set_state(STATE_TOOL, previous)
+            if isinstance(exc, ValueError):      # the tool table knows it, the machine's magazine does not
+                raise InvalidInput(f"tool: {exc}", field="tool") from None
+            raise
+        self._discard(f"T{t} was loaded into the spindle" if t is not None else "The spindle was emptied")
         return self.status()
+
+    # --- what stored measuring points depend on -------------------------------------------------
+    def on_discard(self, listener: Callable[[str], None]) -> None:
+        """``listener(reason)`` when stored measuring points lose their meaning (tool change,
+        scenario load; design.md §9.1)."""
+        self._discard_listeners.append(listener)
+
+    def _discard(self, reason: str) -> None:
+        for listener in self._discard_listeners:
+            listener(reason)
 
     def refresh_tool_offset(self) -> None:
         """Re-read the active tool's data (after a tool table edit) and hand L1 to the NC."""
@@ -360,14 +469,23 @@ class MachineService:
     def _is_settable(self, name) -> bool:
         if name == G500:
             return True
-        with self._db.unit(readonly=True) as unit:
-            names = unit.offset_names()
-        return isinstance(name, str) and name in names and not name.startswith("BASIC")
+        return isinstance(name, str) and name in self._db.offset_names() and not is_basic(name)
+
+    def stored_frames(self) -> dict[str, Frame]:
+        """Every stored frame, read once per database generation (``Database.generation``)."""
+        generation = self._db.generation
+        if self._frames is None or self._frames[0] != generation:
+            with self._db.unit(readonly=True) as unit:
+                self._frames = (generation, {n: Frame.from_api(f) for n, f in unit.list_offsets().items()})
+        return dict(self._frames[1])
+
+    def frames_written(self, generation: int, name: str, frame: Mapping) -> None:
+        """A commit (``generation`` -> +1) that wrote only frame ``name``: the cache takes it."""
+        if self._frames is not None and self._frames[0] == generation and self._db.generation == generation + 1:
+            self._frames = (generation + 1, {**self._frames[1], name: Frame.from_api(frame)})
 
     def build_chain(self, active: str) -> FrameChain:
-        with self._db.unit(readonly=True) as unit:
-            offsets = {n: Frame.from_api(f) for n, f in unit.list_offsets().items()}
-        return frame_chain(offsets, active)
+        return chain_of(self.stored_frames(), active)
 
     def activate(self, name: str) -> dict:
         if not isinstance(name, str) or not self._is_settable(name.upper()):
@@ -390,17 +508,47 @@ class MachineService:
         self.activate(self._active_offset)
 
     # --- scenario -----------------------------------------------------------------------------
-    def load_scenario(self, scenario: Scenario, reset_data: bool = False) -> dict:
+    def _simulator(self, what: str) -> SimulatorControl:
+        """The machine's simulator interface; a real controller has none (409 ``not_simulated``)."""
+        if not isinstance(self._machine, SimulatorControl):
+            raise ConflictError(f"{what} needs the simulator; the controller is {self._machine.controller!r}",
+                                code="not_simulated")
+        return self._machine
+
+    def load_scenario(self, scenario: Scenario | LatheScenario, reset_data: bool = False) -> dict:
         """Reset the machine to ``scenario``; stored data stays unless ``reset_data``."""
+        simulator = self._simulator("a scenario load")
+        self._ensure_idle()
+        self._hold.release()
         with self._lock:
-            self._machine.load(scenario)
+            if getattr(scenario, "kind", "mill") != getattr(self._scenario, "kind", "mill"):
+                self._switch_machine(scenario)
+                reset_data = True            # the other machine's tools, offsets and records mean nothing here
+            else:
+                simulator.load(scenario)
             self._scenario = scenario
             self._seed_data(reset=reset_data)
+            self._push_nc_data()
             self.activate(G500 if reset_data else self._active_offset)
             with self._db.unit(readonly=True) as unit:
                 tool = unit.get_state(STATE_TOOL, None)
             self._restore_tool(tool)
+        self._discard("A scenario was loaded")
         return self.status()
+
+    def _switch_machine(self, scenario: Scenario | LatheScenario) -> None:
+        """A scenario of the other kind (lathe <-> milling machine): build that machine."""
+        if self._rebuild is None:
+            raise InvalidInput(f"this HMI drives a {getattr(self._scenario, 'kind', 'mill')} machine; "
+                               f"start it with the {scenario.kind} scenario", code="invalid_scenario")
+        try:
+            machine = self._rebuild(scenario)
+        except ValueError as exc:
+            raise InvalidInput(str(exc), code="invalid_scenario") from None
+        old, self._machine = self._machine, machine
+        self._hold.close()
+        self._hold = HoldToRun(machine)
+        old.close()
 
     def _restore_tool(self, tool) -> None:
         """Put the stored tool back into the spindle; the probe when none is stored or it is gone."""
@@ -413,6 +561,11 @@ class MachineService:
         """Tool table from the scenario's nominal values (probe included) when empty or on reset;
         on reset also identity offsets, uncalibrated probe records and default settings."""
         sc = self._scenario
+        if isinstance(sc, LatheScenario):
+            lathe_data.seed(self._db, sc, reset, int(self._settings.get().tool_probe_number))
+            if reset:
+                self._settings.reset_to_defaults()
+            return
         with self._db.unit() as unit:
             tools = unit.list_tools()
             if reset:
@@ -430,10 +583,10 @@ class MachineService:
                                            "length": sc.probe.nominal_length,
                                            "radius": sc.probe.nominal_ball_diameter / 2.0,
                                            "wear": {"length": 0.0, "radius": 0.0}})
-                for tool in sc.tools:
-                    unit.put_tool(tool.t, {"type": tool.type, "length": tool.nominal_length,
-                                           "radius": tool.nominal_radius,
-                                           "wear": {"length": 0.0, "radius": 0.0}})
+                for nominal in sc.tools:
+                    unit.put_tool(nominal.t, {"type": nominal.type, "length": nominal.nominal_length,
+                                              "radius": nominal.nominal_radius,
+                                              "wear": {"length": 0.0, "radius": 0.0}})
             if reset:
                 unit.set_state(STATE_TOOL, None)
             if sc.tool_probe is not None:   # its disc diameter is commissioning data, like nominal tool data
@@ -444,16 +597,127 @@ class MachineService:
         if reset:
             self._settings.reset_to_defaults()
 
+    def machine_part(self, scatter_sigma) -> dict:
+        """The next part of the series (design.md §9.3): the stored points of the old one go."""
+        if isinstance(scatter_sigma, bool) or not isinstance(scatter_sigma, int | float) \
+                or not 0.0 <= scatter_sigma <= 1.0:
+            raise InvalidInput("scatter_sigma: a number of mm 0..1", field="scatter_sigma")
+        simulator = self._simulator("the next part")
+        self._ensure_idle()
+        with self._machine_errors():
+            part = simulator.machine_part(float(scatter_sigma))
+        self._discard(f"Part {part} was clamped")
+        return {"part": part, **self.status()}
+
     def scene_geometry(self) -> dict:
-        return self._machine.scene_geometry()
+        return self._simulator("the machine view").scene_geometry()
+
+    # --- the NC's copy of offsets and tools ----------------------------------------------------
+    def _push_nc_data(self) -> None:
+        """Every stored offset and tool to the machine (start-up, scenario load). A value the
+        controller cannot hold does not stop the HMI: its alarm is shown until Reset."""
+        with self._db.unit(readonly=True) as unit:
+            offsets = unit.list_offsets()
+            tools = unit.list_tools()
+        writes = [partial(self._machine.write_offset, name, self._nc_frame(frame)) for name, frame in offsets.items()]
+        writes += [partial(self._machine.write_tool, tool["t"], self._nc_tool(tool)) for tool in tools]
+        for write in writes:
+            try:
+                write()
+            except MachineAlarm as exc:
+                self._machine.post_alarm(exc.alarm)
+
+    def _nc_frame(self, frame: Mapping) -> dict:
+        """A stored frame with the components of the machine's axes (``{"trans", "fine", "rot"}``)."""
+        axes = set(self.axes)
+        return {part: {a: float(v) for a, v in (frame.get(part) or {}).items() if a in axes}
+                for part in ("trans", "fine", "rot")}
+
+    @staticmethod
+    def _nc_tool(data: Mapping) -> dict:
+        """Stored tool data as the Protocol names it: geometry and wear (a lathe tool's SL, L1, L2
+        and their wear too)."""
+        wear = data.get("wear") or {}
+        nc_wear = {"length": float(wear.get("length", 0.0)), "radius": float(wear.get("radius", 0.0))}
+        out: dict[str, object] = {"type": int(data["type"]), "length": float(data["length"]),
+                                  "radius": float(data["radius"]), "wear": nc_wear}
+        if data.get("l1") is not None or data.get("l2") is not None:
+            out.update(sl=int(data.get("sl") or 0), l1=float(data.get("l1") or 0.0), l2=float(data.get("l2") or 0.0))
+            nc_wear.update(l1=float(wear.get("l1") or 0.0), l2=float(wear.get("l2") or 0.0))
+        return out
+
+    def check_holds(self, name: str, frame: Mapping) -> None:
+        """Before the db write: a frame this NC cannot hold as ``name`` (LinuxCNC: a tilted G54, a
+        basic frame) is refused here, a 409 alarm, so the HMI never stores what the NC lacks."""
+        holds = getattr(self._machine, "holds", None)
+        if not callable(holds):
+            return
+        refused = holds(name, self._nc_frame(frame))
+        if refused is not None:
+            self._machine.post_alarm(refused)          # as the NC would show a refused write
+            raise AlarmError(refused.code, refused.text)
+
+    def write_offset(self, name: str, frame: Mapping) -> None:
+        """The stored frame ``name`` to the NC (after the db write); a refusal is a 409 alarm."""
+        with self._machine_errors():
+            self._machine.write_offset(name, self._nc_frame(frame))
+
+    def write_tool(self, t: int, data: Mapping) -> None:
+        """The stored tool data of T ``t`` to the NC (after the db write); a refusal is a 409 alarm."""
+        with self._machine_errors():
+            self._machine.write_tool(int(t), self._nc_tool(data))
 
 
-class PanelState:
-    """Machine control panel selections of the screen (axis, increment, displayed coordinates)."""
+class HoldToRun:
+    """The dead-man of a continuous jog: it runs while renewed, at most ``HOLD_S`` after the last
+    renewal; a watchdog thread stops the axis otherwise (a lost tab, network or server)."""
 
-    INCREMENTS = {"1": 0.001, "10": 0.01, "100": 0.1, "1000": 1.0, "cont": None}
+    HOLD_S = 0.5
+    PERIOD_S = 0.05
 
-    def __init__(self):
-        self.axis = "X"
-        self.increment = "1000"
-        self.coords = "WCS"
+    def __init__(self, machine: Machine):
+        self._machine = machine
+        self._lock = threading.Lock()
+        self._jog: tuple[str, int] | None = None
+        self._deadline = 0.0
+        self._closed = threading.Event()
+        self._thread: threading.Thread | None = None
+
+    def start(self, axis: str, direction: int, feed: float | None) -> None:
+        with self._lock:
+            self._machine.jog_continuous(axis, direction, feed)
+            self._jog, self._deadline = (axis, direction), time.monotonic() + self.HOLD_S
+            if self._thread is None:
+                self._thread = threading.Thread(target=self._watch, name="hold-to-run", daemon=True)
+                self._thread.start()
+
+    def renew(self, axis: str, direction: int) -> bool:
+        """Renew the running jog of ``axis``/``direction``; False when there is none."""
+        with self._lock:
+            if self._jog != (axis, direction) or not self._machine.status().busy:
+                return False
+            self._deadline = time.monotonic() + self.HOLD_S
+            return True
+
+    def release(self) -> bool:
+        """Forget the held jog; True when one was held."""
+        with self._lock:
+            held, self._jog = self._jog is not None, None
+            return held
+
+    def close(self) -> None:
+        self._closed.set()
+        self.release()
+
+    def _watch(self) -> None:
+        while not self._closed.wait(self.PERIOD_S):
+            with self._lock:
+                if self._jog is None:
+                    continue
+                if not self._machine.status().busy:      # ran onto a limit or was stopped
+                    self._jog = None
+                    continue
+                if time.monotonic() < self._deadline:
+                    continue
+                self._jog = None
+            self._machine.stop()

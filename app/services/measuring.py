@@ -2,44 +2,69 @@
 
 from __future__ import annotations
 
-from app.machine.protocol import Alarm, Machine
-from app.services.machine_service import G500, MachineService, basic_frame_names, frame_chain
-from app.services.settings import SettingsService
-from app.workflow.service import MeasuringContext
-from db import Database
-from db.repository import LOG_FIELDS
-from engine.frames import Frame
-from engine.types import ProbeRecord
+import copy
 
-PROBE_TYPES = (710,)
+from pydantic import ValidationError
+
+from app.access.checks import check_actor
+from app.errors import InvalidInput
+from app.machine.protocol import Alarm, Machine
+from app.records import ToolData, frame_out_of_range, is_probe_tool
+from app.services.lathe_data import STATE_GROOVES
+from app.services.machine_service import MachineService
+from app.services.settings import SettingsService
+from app.workflow.context import (
+    MeasuringContext,
+    MeasuringSetup,
+    OffsetChange,
+    OffsetOutcome,
+    ToolOffsetChange,
+    ToolOffsetOutcome,
+)
+from db import Actor, Database, acting_as, current_actor
+from db.repository import LOG_FIELDS
+from engine import alarms
+from engine.frames import G500, Frame, basic_frame_names, chain_of
+from engine.lobing import lobing_map_from_json
+from engine.types import MeasuringError, ProbeRecord
 
 
 def probe_record_from(data: dict | None, tool: dict | None, length_to_tip: bool) -> ProbeRecord:
     """ProbeRecord from the stored _WP record and the tool data of the probe in the spindle."""
     data = data or {}
+    skew = data.get("skew") or (0.0, 0.0)          # (x, y): a stored record is checked (app.records)
     ball = 2.0 * float(tool["radius"]) if tool and tool.get("radius") else float(data.get("ball_diameter", 4.0))
     return ProbeRecord(
         number=int(data.get("number", 1)),
         ball_diameter=ball,
         effective_diameter=float(data.get("effective_diameter", 0.0) or 0.0),
         trigger={k: float(v) for k, v in (data.get("trigger") or {}).items()},
-        skew=tuple(float(v) for v in (data.get("skew") or (0.0, 0.0))),
+        skew=(float(skew[0]), float(skew[1])),
         length_to_tip=bool(length_to_tip),
         calibrated_radius=bool(data.get("calibrated_radius", False)),
         calibrated_length=bool(data.get("calibrated_length", False)),
         calibration_feed=data.get("calibration_feed"),
         calibration_override=data.get("calibration_override"),
+        lobing=lobing_map_from_json(data["lobing"]) if data.get("lobing") else None,
     )
 
 
 def probe_number_for(records: list[dict], spindle_tool: int | None, gud_probe_number: int) -> int:
     """The active _WP record follows the tool in the spindle: the record calibrated with (bound
-    to) that T; else _JM_I[1] (_PRNUM: the last two digits are the probe number, spec §8.1)."""
+    to) that T; else _JM_I[1] (_PRNUM: the last two digits are the probe number, jog-measuring §8.1)."""
     if spindle_tool is not None:
         for record in records:
             if record.get("tool") == spindle_tool:
                 return int(record["number"])
     return int(gud_probe_number) % 100 or 1
+
+
+def lathe_records(unit) -> dict:
+    """The lathe's data records as stored: _TP/_TPW (tool probe records), _WP (probe records),
+    _KB (reference grooves) and the EV/MV memories (turning.md §0.7, turning §10.2)."""
+    return {"tool_probes": unit.list_tool_probes(), "probes": unit.list_probes(),
+            "grooves": unit.get_state(STATE_GROOVES, None) or [],
+            "memories": {"EV": unit.list_memories("EV"), "MV": unit.list_memories("MV")}}
 
 
 class MeasuringEnv:
@@ -49,58 +74,177 @@ class MeasuringEnv:
         self._db = db
         self._ms = machine_service
         self._settings = settings
+        self._cache: tuple | None = None
+        self._start_actor: Actor | None = None      # who pressed NC Start (for a measurement that runs on in a thread)
 
     @property
     def machine(self) -> Machine:
         return self._ms.machine
 
-    def measuring_context(self) -> MeasuringContext:
-        st = self._ms.machine.status()
-        gud = self._settings.get()
+    def release_jog(self) -> None:
+        """NC Start begins a measurement: forget a held jog, so that its dead-man watchdog cannot
+        stop the measurement's motion (a late renewal may have restarted the jog)."""
+        self._ms.release_jog()
+
+    def _stored(self, tool_no: int | None, gud) -> tuple:
+        """(frames, tool row, probe number, probe record, tool-probe record) as stored; read once
+        per database generation (nothing written since: the same values)."""
+        key = (self._db.generation, tool_no, int(gud.probe_number), int(gud.tool_probe_number))
+        cached = self._cache
+        if cached is not None and cached[0] == key:
+            return cached[1]
         with self._db.unit(readonly=True) as unit:
             offsets = {n: Frame.from_api(f) for n, f in unit.list_offsets().items()}
-            tool = unit.get_tool(st.tool) if st.tool is not None else None
-            probe_no = probe_number_for(unit.list_probes(), st.tool, int(gud.probe_number))
+            tool = unit.get_tool(tool_no) if tool_no is not None else None
+            probe_no = probe_number_for(unit.list_probes(), tool_no, int(gud.probe_number))
             probe_data = unit.get_probe(probe_no)
             tool_probe = unit.get_tool_probe(int(gud.tool_probe_number))
-        is_probe = bool(tool) and int(tool.get("type", 0)) in PROBE_TYPES
+            lathe = lathe_records(unit) if self._ms.is_lathe else None
+        value = (offsets, tool, probe_no, probe_data, tool_probe, lathe)
+        self._cache = (key, value)
+        return value
+
+    def measuring_context(self) -> MeasuringContext:
+        if current_actor() is not None:     # NC Start asks for the context in the request's thread
+            self._start_actor = current_actor()
+        st = self._ms.machine.status()
+        gud = self._settings.get()
+        offsets, tool, probe_no, probe_data, tool_probe, lathe = self._stored(st.tool, gud)
+        tool = dict(tool) if tool is not None else None            # callers may not change the cache
+        probe_data = dict(probe_data) if probe_data is not None else None
+        is_probe = is_probe_tool(tool)
         probe = probe_record_from(probe_data, tool, gud.length_to_tip) if is_probe else None
         active = self._ms.active_offset
         return MeasuringContext(
             active_offset=active,
-            offsets=offsets,
-            frame_chain=frame_chain(offsets, active),
+            offsets=dict(offsets),
+            frame_chain=chain_of(offsets, active),
             basic_names=basic_frame_names(offsets),
             plane=self._ms.plane(),
             tool_length=float(st.tool_length),
             tool=tool,
             spindle_angle=float(st.spindle_angle),
             feed_override=float(st.feed_override),
-            settings=gud.model_dump(),
+            settings=gud,
             probe=probe,
             probe_data=probe_data,
             extra={"tool_probe": tool_probe, "tool_probe_number": int(gud.tool_probe_number),
-                   "probe_number": probe_no, "active_is_g500": active == G500},
+                   "probe_number": probe_no, "active_is_g500": active == G500,
+                   **({"lathe": self._lathe_extra(st, lathe)} if lathe is not None else {})},
         )
 
-    def commit_measurement(self, *, offset=None, log_entry: dict, probe_update=None, tool_update=None,
-                           tool_probe_update=None) -> int:
-        """Offset + audit + log (+ probe/tool records) in one transaction (design.md §6)."""
+    def _lathe_extra(self, st, records: dict) -> dict:
+        """What the turning cycles read besides the tool (app.workflow.finish_lathe.lathe_context):
+        the NC's lengths of the active tool, DIAMON, Y, SPOS capability, the records."""
+        machine = self._ms.machine
+        return {**copy.deepcopy(records), "tool_lengths": tuple(getattr(st, "tool_lengths", (0.0, 0.0))),
+                "diamon": self._ms.diameter_programming, "has_y": "Y" in tuple(machine.axes),
+                "spos": bool(getattr(machine, "spos_capable", True))}
+
+    def measuring_setup(self) -> MeasuringSetup:
+        return MeasuringSetup(self._ms.plane(), self._ms.active_offset, tuple(self._db.offset_names()),
+                              self._settings.get())
+
+    def commit_measurement(self, *, offset: OffsetChange | None = None, log_entry: dict, probe_update=None,
+                           tool_update=None, tool_probe_update=None, tool_offset: ToolOffsetChange | None = None
+                           ) -> tuple[int, OffsetOutcome | ToolOffsetOutcome | None]:
+        """Offset + audit + log (+ probe/tool records) in one transaction (design.md §6, §9.1).
+
+        The offset is computed here, from the frames as stored inside the transaction; a result
+        that is not finite or beyond the offset limits is refused (422 ``correction_out_of_range``)
+        and nothing is written.
+
+        Every write is audited naming who measured (the request's identity; for a measurement that
+        runs on in the workflow's own thread, the one that pressed NC Start), and refused (403
+        ``access_level``, nothing written) when that identity's level is too low for it."""
+        calibration = probe_update is not None or tool_probe_update is not None
+        functions = [f for f, writes in (("offsets", offset is not None),
+                                         ("calibration", calibration),
+                                         ("tools", (tool_update is not None or tool_offset is not None)
+                                          and not calibration)) if writes]
+        with acting_as(current_actor() or self._start_actor):
+            check_actor(self._settings, functions)
+            return self._commit(offset, log_entry, probe_update, tool_update, tool_probe_update, tool_offset,
+                                "calibration" if calibration else "measure")
+
+    def _commit(self, offset, log_entry, probe_update, tool_update, tool_probe_update, tool_offset, source):
         entry = {k: v for k, v in log_entry.items() if k in LOG_FIELDS}
+        outcome = stored_offset = stored_tool = None
+        generation = self._db.generation
         with self._db.unit() as unit:
             if offset is not None:
-                name, _before, after, detail = offset
-                unit.put_offset(name, after, source="measure", detail=detail)
+                outcome = offset.compute(self._frames_in(unit, generation))
+                wrong = frame_out_of_range(outcome.after)
+                if wrong:
+                    raise InvalidInput(f"The measured correction would make {offset.target} {wrong[1]}: "
+                                       "check the setpoints and the probe data", field=wrong[0],
+                                       code="correction_out_of_range")
+                self._ms.check_holds(offset.target, outcome.after)
+                _before, after = unit.put_offset(offset.target, outcome.after, source="measure",
+                                                 detail=outcome.detail)
+                stored_offset = (offset.target, after)
+                entry["correction"] = outcome.answer.get("correction")
+            detail = {"task": entry.get("task")}
+            if tool_offset is not None:
+                outcome = self._tool_offset(unit, tool_offset, entry)
+                if outcome.after is not None:
+                    tool_update = (outcome.tool, outcome.after)
             if probe_update is not None:
-                unit.put_probe(probe_update[0], probe_update[1])
+                unit.put_probe(probe_update[0], probe_update[1], source=source, detail=detail)
             if tool_update is not None:
-                unit.put_tool(tool_update[0], tool_update[1])
+                stored_tool = unit.put_tool(tool_update[0], tool_update[1], source=source, detail=detail)
             if tool_probe_update is not None:
-                unit.put_tool_probe(tool_probe_update[0], tool_probe_update[1])
+                unit.put_tool_probe(tool_probe_update[0], tool_probe_update[1], source=source, detail=detail)
             log_id = unit.add_log(entry)
-        if tool_update is not None:
+        if stored_offset is not None and not (probe_update or tool_update or tool_probe_update):
+            self._written(generation, *stored_offset)
+        if stored_offset is not None:          # the NC holds what was stored
+            self._ms.write_offset(*stored_offset)
+        if stored_tool is not None:
+            self._ms.write_tool(stored_tool["t"], stored_tool)
             self._ms.refresh_tool_offset()
-        return log_id
+        return log_id, outcome
+
+    def _frames_in(self, unit, generation: int) -> dict[str, Frame]:
+        """The stored frames inside the write transaction: the cached ones when nothing was
+        written since they were read (the write lock is held, so nothing can be meanwhile)."""
+        unit.hold_write_lock()                    # no other writer from here until the commit
+        cached = self._cache
+        if cached is not None and cached[0][0] == generation == self._db.generation:
+            return dict(cached[1][0])
+        return {n: Frame.from_api(f) for n, f in unit.list_offsets().items()}
+
+    def _written(self, generation: int, name: str, frame: dict) -> None:
+        """Our own commit of one frame: the caches take it, nothing else changed."""
+        if self._db.generation != generation + 1:
+            return
+        cached = self._cache
+        if cached is not None and cached[0][0] == generation:
+            key, (offsets, *rest) = cached
+            self._cache = ((generation + 1, *key[1:]), ({**offsets, name: Frame.from_api(frame)}, *rest))
+        self._ms.frames_written(generation, name, frame)
+
+    @staticmethod
+    def _tool_offset(unit, change: ToolOffsetChange, entry: dict) -> ToolOffsetOutcome:
+        """The tool-offset decision from the tool data and memories as stored in this transaction."""
+        tool = unit.get_tool(change.tool)
+        if tool is None:
+            raise MeasuringError(alarms.TOOL_NUMBER, f"T{change.tool} is not in the tool table")
+        outcome = change.compute(tool, unit.get_memory)
+        if outcome.after is not None:
+            try:
+                ToolData.model_validate({**tool, **outcome.after, "t": change.tool})
+            except ValidationError as exc:
+                first = exc.errors()[0]
+                where = ".".join(str(p) for p in first["loc"])
+                raise InvalidInput(f"The tool offset would make T{change.tool} {where} out of range "
+                                   f"({first['msg']}): check the tolerance parameters", field=where,
+                                   code="correction_out_of_range") from None
+        for (kind, number), value in outcome.memories.items():
+            unit.put_memory(kind, number, value, source="measure", detail={"task": entry.get("task")})
+        entry["result"] = {**(entry.get("result") or {}), **outcome.result}
+        entry["correction"] = outcome.correction
+        return outcome
 
     def activate(self, name: str) -> None:
         self._ms.activate(name)

@@ -6,7 +6,7 @@ invalid, discard its measurement". Bits 4..7 (HMI -> PLC) are owned by the HMI a
 open measuring session's stored points (``MeasureSession.plc_byte()``), so they are 0 with no
 session, after Calculate and after the screen was left, by construction.
 
-Handshake ([I] §3.2):
+Handshake ([I] jog-measuring §3.2):
 
 1. HMI sets bit 4+n-1 when Pn is stored (the session does that).
 2. PLC sets bit n-1 (``write(n-1, True)``).
@@ -30,8 +30,8 @@ import time
 from collections import deque
 from collections.abc import Callable
 
-from app.errors import InvalidInput
-from app.workflow.service import WorkflowError, WorkflowService
+from app.errors import InvalidInput, WorkflowError
+from app.workflow.service import WorkflowService
 
 PLC_BITS = range(0, 4)         # PLC -> HMI: discard request for P1..P4
 HMI_BITS = range(4, 8)         # HMI -> PLC: P1..P4 measured and stored

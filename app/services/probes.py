@@ -6,74 +6,13 @@ every record has the same keys. A PUT replaces the record (keys not given get th
 
 from __future__ import annotations
 
-from typing import Literal
-
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import BaseModel, ValidationError
 
 from app.errors import InvalidInput, NotFoundError
+from app.records import LATHE_RECORD_KEYS, MAX_PROBE, ProbeData, ToolProbeData
 from db import Database
-from engine.types import TRIGGER_KEYS
 
 from .settings import raise_invalid
-
-MAX_PROBE = 99
-
-
-def _check_trigger_keys(value: dict[str, float]) -> dict[str, float]:
-    unknown = sorted(set(value) - set(TRIGGER_KEYS))
-    if unknown:
-        raise ValueError(f"unknown direction(s) {unknown}; use {list(TRIGGER_KEYS)}")
-    return value
-
-
-class ProbeData(BaseModel):
-    """_WP[k]: mirrors ``engine.types.ProbeRecord`` (trigger = ball centre minus surface per direction)."""
-
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-    number: int = Field(1, ge=1, le=MAX_PROBE)
-    ball_diameter: float = Field(4.0, gt=0, le=100)
-    effective_diameter: float = Field(0.0, ge=0, le=100)     # 0 = not calibrated
-    trigger: dict[str, float] = Field(default_factory=dict)
-    skew: tuple[float, float] = (0.0, 0.0)
-    length_to_tip: bool = False
-    calibrated_radius: bool = False
-    calibrated_length: bool = False
-    calibrated_plane: Literal["G17", "G18", "G19"] | None = None
-    calibration_feed: float | None = Field(None, gt=0)
-    calibration_override: float | None = Field(None, ge=0, le=120)
-    calibrated_at: str | None = None
-    tool: int | None = Field(None, ge=1, le=9999)               # T of the probe this record belongs to
-    cal_ring_diameter: float | None = Field(None, gt=0, le=1000)  # gauge of the radius calibration
-    cal_height: float | None = Field(None, ge=-10000, le=10000)   # surface of the length calibration
-    cal_wo: str | None = Field(None, max_length=12)              # WO the calibration was measured in
-
-    @field_validator("trigger")
-    @classmethod
-    def _trigger_keys(cls, value: dict[str, float]) -> dict[str, float]:
-        return _check_trigger_keys(value)
-
-
-class ToolProbeData(BaseModel):
-    """_TP[k]: trigger values in MCS of the tool edge at switching (spec §7.2)."""
-
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-    number: int = Field(1, ge=1, le=MAX_PROBE)
-    trigger: dict[str, float] = Field(default_factory=dict)
-    disc_diameter: float = Field(0.0, ge=0, le=500)
-    axes: int = Field(133, ge=0, le=333)
-    type: Literal[0, 101, 201, 301] = 0
-    dz: float = Field(2.0, ge=0, le=100)
-    calibrated_length: bool = False
-    calibrated_diameter: bool = False
-    calibration_tool: int | None = Field(None, ge=1)
-    calibration_feed: float | None = Field(None, gt=0)
-    calibration_override: float | None = Field(None, ge=0, le=120)   # feed override when calibrated
-    calibrated_at: str | None = None
-
-    @field_validator("trigger")
-    @classmethod
-    def _trigger_keys(cls, value: dict[str, float]) -> dict[str, float]:
-        return _check_trigger_keys(value)
 
 
 class _Records:
@@ -90,7 +29,9 @@ class _Records:
 
     def _complete(self, stored: dict) -> dict:
         defaults = self.model().model_dump(mode="json")
-        return {**defaults, **{k: v for k, v in stored.items() if k in defaults}}
+        out = {**defaults, **{k: v for k, v in stored.items() if k in defaults}}
+        # the lathe's fields (position_deviation, workpiece_trigger) only where a lathe wrote them
+        return {k: v for k, v in out.items() if not (k in LATHE_RECORD_KEYS and v is None)}
 
     def validate(self, n: int, data: dict) -> dict:
         n = self.check_number(n)
@@ -106,7 +47,7 @@ class _Records:
     def _read(self, unit, n: int) -> dict | None:
         raise NotImplementedError
 
-    def _write(self, unit, n: int, data: dict) -> dict:
+    def _write(self, unit, n: int, data: dict, source: str | None = None, detail: dict | None = None) -> dict:
         raise NotImplementedError
 
     def _all(self, unit) -> list[dict]:
@@ -124,10 +65,29 @@ class _Records:
             raise NotFoundError(f"no {self.what} record {n}", code=f"unknown_{self.what.replace(' ', '_')}")
         return self._complete(stored)
 
-    def put(self, n: int, data: dict) -> dict:
+    def put(self, n: int, data: dict, source: str = "api") -> dict:
+        """Audited (kind "probe" item "WP<n>", or "tool_probe" "TP<n>")."""
         record = self.validate(n, data)
         with self._db.unit() as unit:
-            return self._complete(self._write(unit, n, record))
+            return self._complete(self._write(unit, n, record, source))
+
+    def restore(self, entry: dict, force: bool = False) -> dict:
+        """Undo of a record change (source "undo")."""
+        from app.errors import ConflictError
+
+        from .offsets import same_values
+
+        name = entry["offset"]
+        n = int(name[2:])
+        with self._db.unit() as unit:
+            current = self._read(unit, n)
+            if not force and not same_values(current, entry["after"]):
+                raise ConflictError(f"{name} changed after change #{entry['id']}; send {{\"force\": true}} to "
+                                    "restore anyway", code="changed_since")
+            stored = self._write(unit, n, entry["before"] or {"number": n}, "undo", {"undo_of": entry["id"]})
+            new_id = unit.audit(1, name)[0]["id"]
+        return {"undone": entry["id"], "audit_id": new_id, "kind": entry["kind"], "offset": name,
+                "value": self._complete(stored)}
 
 
 class ProbeService(_Records):
@@ -137,8 +97,8 @@ class ProbeService(_Records):
     def _read(self, unit, n):
         return unit.get_probe(n)
 
-    def _write(self, unit, n, data):
-        return unit.put_probe(n, data)
+    def _write(self, unit, n, data, source=None, detail=None):
+        return unit.put_probe(n, data, source=source, detail=detail)
 
     def _all(self, unit):
         return unit.list_probes()
@@ -151,8 +111,8 @@ class ToolProbeService(_Records):
     def _read(self, unit, n):
         return unit.get_tool_probe(n)
 
-    def _write(self, unit, n, data):
-        return unit.put_tool_probe(n, data)
+    def _write(self, unit, n, data, source=None, detail=None):
+        return unit.put_tool_probe(n, data, source=source, detail=detail)
 
     def _all(self, unit):
         return unit.list_tool_probes()

@@ -14,22 +14,17 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 from app.errors import InvalidInput
+from app.records import PROBE_TOOL_TYPE, is_probe_tool
 from app.services.measuring import MeasuringEnv
-from app.workflow.planning import ALARM_DIAMETER, ALARM_NO_TOOL, ALARM_PROBE_AS_TOOL, tool_probe_widths
-from engine.plan import TASK_POINTS
+from app.workflow.planning import tool_probe_widths
+from app.workflow.tasks import TASKS, Category, task_spec
+from engine import alarms
 
-WORKPIECE, PROBE_CAL, TOOLPROBE_CAL, TOOL = "workpiece", "probe_calibration", "tool_probe_calibration", \
-    "tool_measuring"
+WORKPIECE, PROBE_CAL, TOOLPROBE_CAL, TOOL = (c.value for c in (
+    Category.WORKPIECE, Category.PROBE_CALIBRATION, Category.TOOL_PROBE_CALIBRATION, Category.TOOL_MEASURING))
 CATEGORIES = (WORKPIECE, PROBE_CAL, TOOLPROBE_CAL, TOOL)
 ALL = CATEGORIES
-PROBE_TYPE = 710
 
-ALARM_PROBE_TYPE = 61309        # Check probe type
-ALARM_SCALE = 61310             # Scale factor active
-ALARM_NO_D = 61311              # No D number active
-ALARM_NO_GEOAX = 61336          # No geometry axis
-ALARM_NOT_CALIBRATED = 61341    # Probe not calibrated in active plane
-ALARM_TOOL_ZERO = 61351         # Tool length or radius is 0
 
 
 @dataclass(frozen=True)
@@ -48,8 +43,7 @@ class Check:
 
 
 def category_of(task: str) -> str:
-    family = task.split(".")[0]
-    return {"probe": PROBE_CAL, "toolprobe": TOOLPROBE_CAL, "tool": TOOL}.get(family, WORKPIECE)
+    return task_spec(task).category.value
 
 
 class ReadinessService:
@@ -57,12 +51,12 @@ class ReadinessService:
         self._services = services
 
     def report(self, task: str | None = None) -> dict:
-        if task is not None and task not in TASK_POINTS:
+        if task is not None and task not in TASKS:
             raise InvalidInput(f"task: unknown measuring task {task!r}", field="task")
         checks = self.checks(task)
         ready = {c: not any(not k.ok and k.severity == "error" and c in k.applies for k in checks)
                  for c in CATEGORIES}
-        answer = {"task": task, "ready": ready, "checks": [c.to_api() for c in checks]}
+        answer: dict[str, object] = {"task": task, "ready": ready, "checks": [c.to_api() for c in checks]}
         if task is not None:
             cat = category_of(task)
             relevant = [c for c in checks if cat in c.applies and not c.ok]
@@ -81,7 +75,7 @@ class ReadinessService:
         plane = ctx.plane
         tool = ctx.tool
         t = status.tool
-        is_probe = bool(tool) and int(tool.get("type", 0)) == PROBE_TYPE
+        is_probe = is_probe_tool(tool)
         probe_data = ctx.probe_data or {}
         tool_probe = (ctx.extra or {}).get("tool_probe") or {}
         tp_n = (ctx.extra or {}).get("tool_probe_number", 1)
@@ -90,7 +84,7 @@ class ReadinessService:
         # --- machine -------------------------------------------------------------------------
         geo = [a for a in ("X", "Y", "Z") if a in s.machine.axes]
         out.append(Check("geometry_axes", "Machine", "All three geometry axes exist", len(geo) == 3,
-                         f"geometry axes {', '.join(geo) or 'none'}", ALARM_NO_GEOAX))
+                         f"geometry axes {', '.join(geo) or 'none'}", alarms.NO_GEOMETRY_AXIS.number))
         out.append(Check("referenced", "Machine", "Machine axes referenced", True,
                          "the simulated axes are referenced at power-on"))
         newest = status.alarms[-1] if status.alarms else None
@@ -107,17 +101,17 @@ class ReadinessService:
         if t is None:
             msg = "no tool in the spindle: load the 3D probe"
         elif is_probe:
-            msg = f"T{t} is the 3D probe (type {PROBE_TYPE})"
+            msg = f"T{t} is the 3D probe (type {PROBE_TOOL_TYPE})"
         else:
-            msg = f"T{t} is type {tool.get('type') if tool else '?'}, not a 3D probe (type {PROBE_TYPE})"
+            msg = f"T{t} is type {tool.get('type') if tool else '?'}, not a 3D probe (type {PROBE_TOOL_TYPE})"
         out.append(Check("probe_active", "Probe", "Workpiece probe is the active tool", is_probe, msg,
-                         ALARM_PROBE_TYPE, "error", wp))
+                         alarms.PROBE_TYPE.number, "error", wp))
         length = float(status.tool_length)
         has_d = t is not None and tool is not None and length > 0
         out.append(Check("probe_offset", "Probe", "Tool offset (D number) of the probe active",
                          has_d and is_probe,
                          f"L1 = {length:.3f} mm" if has_d else "no tool offset active",
-                         ALARM_NO_D, "error", wp))
+                         alarms.NO_D_NUMBER.number, "error", wp))
         cal_plane = probe_data.get("calibrated_plane")
         cal_r, cal_l = bool(probe_data.get("calibrated_radius")), bool(probe_data.get("calibrated_length"))
         plane_ok = cal_plane in (None, plane.name)
@@ -133,7 +127,7 @@ class ReadinessService:
             msg = ("not calibrated: " + ", ".join(missing)
                    + "; measuring is allowed, results carry pre-travel and eccentricity")
         out.append(Check("probe_calibrated", "Probe", f"Probe calibrated in the active plane {plane.name}",
-                         calibrated, msg, ALARM_NOT_CALIBRATED, "warning", (WORKPIECE,)))
+                         calibrated, msg, alarms.NOT_CALIBRATED_IN_PLANE.number, "warning", (WORKPIECE,)))
         cal_ovr = probe_data.get("calibration_override")
         ovr_ok = cal_ovr is None or abs(float(cal_ovr) - float(status.feed_override)) < 1e-9
         out.append(Check("override", "Probe", "Feed override as during calibration", ovr_ok,
@@ -143,31 +137,31 @@ class ReadinessService:
         out.append(Check("plane", "Probe", "Working plane", True,
                          f"{plane.name}: infeed axis {plane.infeed}", None, "warning", wp))
         out.append(Check("no_scale", "Probe", "No scale factor in the frames", True,
-                         "frames carry translation and rotation only", ALARM_SCALE, "error", wp))
+                         "frames carry translation and rotation only", alarms.SCALE_FACTOR.number, "error", wp))
 
         # --- tool measuring -----------------------------------------------------------------
         tl = (TOOLPROBE_CAL, TOOL)
         cutter = tool is not None and not is_probe
         if tool is None:
-            msg, alarm = "no tool in the spindle: load the tool to measure", ALARM_NO_TOOL
+            msg, alarm = "no tool in the spindle: load the tool to measure", alarms.NO_D_NUMBER.number
         elif is_probe:
-            msg, alarm = f"T{t} is the workpiece probe: load a cutter", ALARM_PROBE_AS_TOOL
+            msg, alarm = f"T{t} is the workpiece probe: load a cutter", alarms.TOOL_TYPE.number
         else:
-            msg, alarm = f"T{t} (type {tool.get('type')})", ALARM_NO_TOOL
+            msg, alarm = f"T{t} (type {tool.get('type')})", alarms.NO_D_NUMBER.number
         out.append(Check("cutter_active", "Tool", "A cutter is the active tool", cutter, msg, alarm,
                          "error", tl))
-        if cutter:
+        if cutter and tool is not None:
             radius = float(tool.get("radius", 0.0)) + float((tool.get("wear") or {}).get("radius", 0.0))
             data_ok = length > 0 and radius > 0
             msg = f"L1 {length:.3f} mm, R {radius:.3f} mm"
         else:
             data_ok, msg = False, "no cutter in the spindle"
         out.append(Check("tool_data", "Tool", "Approximate tool length and radius entered", data_ok, msg,
-                         ALARM_TOOL_ZERO, "error", (TOOL,)))
+                         alarms.TOOL_SIZE_ZERO.number, "error", (TOOL,)))
         dl, dr = tool_probe_widths(ctx.settings, tool_probe)
         out.append(Check("tool_probe_widths", "Tool", "Tool probe effective diameter set",
                          dl > 0 and dr > 0, f"E_MESS_MT_DL {dl:g} mm, E_MESS_MT_DR {dr:g} mm",
-                         ALARM_DIAMETER, "error", tl))
+                         alarms.TOOL_PROBE_DIAMETER.number, "error", tl))
         tp_l, tp_d = bool(tool_probe.get("calibrated_length")), bool(tool_probe.get("calibrated_diameter"))
         need_d = task == "tool.diameter"
         tp_ok = tp_l and (tp_d or not need_d)
@@ -175,5 +169,5 @@ class ReadinessService:
                           for w, ok in (("length", tp_l), ("diameter", tp_d)))
         out.append(Check("tool_probe_calibrated", "Tool",
                          f"Tool probe {tp_n} calibrated" + (" (length and diameter)" if need_d else ""),
-                         tp_ok, state, ALARM_NOT_CALIBRATED, "error", (TOOL,)))
+                         tp_ok, state, alarms.NOT_CALIBRATED_IN_PLANE.number, "error", (TOOL,)))
         return out

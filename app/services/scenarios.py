@@ -6,10 +6,12 @@ import json
 from pathlib import Path
 
 from app.config import Settings
+from app.machine.lathe_scenario import LatheScenario
 from app.machine.scenario import Scenario, demo_scenario, load_scenario
 
 
-def read_scenario(settings: Settings) -> Scenario:
+def read_scenario(settings: Settings) -> Scenario | LatheScenario:
+    scenario: Scenario | LatheScenario
     if settings.scenario_path is None:
         scenario = demo_scenario()
     else:
@@ -17,7 +19,7 @@ def read_scenario(settings: Settings) -> Scenario:
     return with_time_scale(scenario, settings.time_scale)
 
 
-def with_time_scale(scenario: Scenario, time_scale: float | None) -> Scenario:
+def with_time_scale(scenario: Scenario | LatheScenario, time_scale: float | None) -> Scenario | LatheScenario:
     """``machine.time_scale`` replaced when the process was started with an override (tests: 0)."""
     if time_scale is None:
         return scenario

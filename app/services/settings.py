@@ -3,15 +3,16 @@
 from __future__ import annotations
 
 import threading
+from typing import NoReturn
 
 from pydantic import ValidationError
 
 from app.errors import InvalidInput
-from app.gud import GudSettings
+from app.gud import GudSettings, legacy_units
 from db import Database
 
 
-def raise_invalid(error: ValidationError, prefix: str = "") -> None:
+def raise_invalid(error: ValidationError, prefix: str = "") -> NoReturn:
     """First pydantic error -> InvalidInput naming the field (``prefix`` + location)."""
     first = error.errors()[0]
     field = prefix + ".".join(str(p) for p in first["loc"])
@@ -47,7 +48,7 @@ class SettingsService:
         """Current settings with ``values`` applied; InvalidInput names the first bad field."""
         if not isinstance(values, dict):
             raise InvalidInput("settings must be an object")
-        merged = {**self.get().model_dump(), **values}
+        merged = {**self.get().model_dump(), **legacy_units(values, self.get().model_dump())}
         try:
             settings = GudSettings.model_validate(merged)
         except ValidationError as error:
@@ -57,7 +58,7 @@ class SettingsService:
 
     def check(self, values: dict) -> tuple[GudSettings | None, dict[str, str]]:
         """Like ``validate`` but collects every bad field (for the settings form)."""
-        merged = {**self.get().model_dump(), **values}
+        merged = {**self.get().model_dump(), **legacy_units(values, self.get().model_dump())}
         try:
             settings = GudSettings.model_validate(merged)
         except ValidationError as error:
@@ -68,16 +69,41 @@ class SettingsService:
             return None, {error.field or "": error.message}
         return settings, {}
 
-    def put(self, values: dict) -> GudSettings:
+    def put(self, values: dict, source: str = "api") -> GudSettings:
+        """Audited (kind "settings"): the keys that changed, before and after."""
         settings = self.validate(values)
         with self._lock:
+            old = self.get_unlocked().model_dump()
+            new = settings.model_dump()
+            changed = sorted(k for k in new if new[k] != old.get(k))
             with self._db.unit() as unit:
-                unit.put_settings(settings.model_dump())
+                unit.put_settings(new)
+                if changed:
+                    unit.add_audit("settings", "settings", {k: old.get(k) for k in changed},
+                                   {k: new[k] for k in changed}, source)
             self._cached = settings
         return settings
 
+    def get_unlocked(self) -> GudSettings:
+        if self._cached is None:
+            with self._db.unit(readonly=True) as unit:
+                self._cached = _lenient(unit.get_settings())
+        return self._cached
+
+    def changes_levels(self, values) -> bool:
+        """``values`` change the access-level table (a ``level_*`` setting)."""
+        if not isinstance(values, dict):
+            return False
+        current = self.get()
+        return any(key.startswith("level_") and key in GudSettings.model_fields and value != getattr(current, key)
+                   for key, value in values.items())
+
     def reset_to_defaults(self) -> GudSettings:
-        return self.put(GudSettings().model_dump())
+        """The measuring settings' defaults; the access-level table (``level_*``) stays as it is:
+        it is the plant's access configuration, not measuring data."""
+        current = self.get()
+        defaults = {k: v for k, v in GudSettings().model_dump().items() if not k.startswith("level_")}
+        return self.put({**current.model_dump(), **defaults}, source="scenario")
 
     def _check_wo(self, settings: GudSettings) -> None:
         if settings.measuring_wo in ("G500", "active"):
@@ -91,6 +117,7 @@ class SettingsService:
 
 def _lenient(stored: dict) -> GudSettings:
     defaults = GudSettings()
+    stored = legacy_units(stored)           # a database of wave 1: inch_display without units
     values = {}
     for key, value in stored.items():
         if key not in GudSettings.model_fields:

@@ -1,37 +1,19 @@
-"""Tool table (geometry and wear). A write to the tool in the spindle updates the NC's L1."""
+"""Tool table (geometry and wear). Each write goes to the NC's tool data once stored; a write to
+the tool in the spindle also updates the NC's L1."""
 
 from __future__ import annotations
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import ValidationError
 
 from app.errors import ConflictError, InvalidInput, NotFoundError
+from app.records import MAX_TOOL, ToolData
 from db import Database
 
 from .machine_service import MachineService
 from .settings import raise_invalid
 
-MAX_TOOL = 9999
-
-
-class Wear(BaseModel):
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-    length: float = Field(0.0, ge=-100, le=100)
-    radius: float = Field(0.0, ge=-100, le=100)
-
-
-class ToolData(BaseModel):
-    """``{"t", "name", "type", "length", "radius", "wear": {"length", "radius"}}`` (design.md §4)."""
-
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-    t: int = Field(ge=1, le=MAX_TOOL)
-    name: str | None = Field(None, max_length=40)
-    type: int = Field(120, ge=100, le=999)          # 1xx mills, 2xx drills, 710 3D probe
-    length: float = Field(0.0, ge=0, le=2000)
-    radius: float = Field(0.0, ge=0, le=500)
-    wear: Wear = Field(default_factory=Wear)
-
-
-TOOL_FIELDS = ("name", "type", "length", "radius", "wear.length", "wear.radius")
+TOOL_FIELDS = ("name", "type", "length", "radius", "wear.length", "wear.radius",
+               "sl", "l1", "l2", "wear.l1", "wear.l2")          # the last five: lathe tools (turning.md §10.2)
 
 
 class ToolService:
@@ -74,18 +56,49 @@ class ToolService:
         except ValidationError as error:
             raise_invalid(error)
 
-    def put(self, t: int, changes: dict) -> dict:
+    def put(self, t: int, changes: dict, source: str = "api") -> dict:
+        """Audited (kind "tool", item "T<t>", ``source``)."""
         data = self.validate(t, changes)
         with self._db.unit() as unit:
-            stored = unit.put_tool(data["t"], data)
-        if self._machine.machine.status().tool == stored["t"]:
-            self._machine.refresh_tool_offset()
+            stored = unit.put_tool(data["t"], data, source=source)
+        self._stored(stored)
         return stored
 
-    def put_field(self, t: int, field: str, text: str) -> dict:
+    def _stored(self, stored: dict) -> None:
+        self._machine.write_tool(stored["t"], stored)    # the NC holds what was stored
+        if self._machine.machine.status().tool == stored["t"]:
+            self._machine.refresh_tool_offset()
+
+    def restore(self, entry: dict, force: bool = False) -> dict:
+        """Undo of a tool change (source "undo"); a creation is undone by deleting the tool."""
+        from .offsets import same_values
+
+        t = int(entry["offset"].removeprefix("T"))
+        before = entry["before"]
+        if before is None and self._machine.machine.status().tool == t:
+            raise ConflictError(f"T{t} is in the spindle; change the tool first", code="tool_in_spindle")
+        with self._db.unit() as unit:
+            current = unit.get_tool(t)
+            if not force and not same_values(current, entry["after"]):
+                raise ConflictError(f"T{t} changed after change #{entry['id']}; send {{\"force\": true}} to "
+                                    "restore anyway", code="changed_since")
+            if before is None:
+                if current is not None:
+                    unit.delete_tool(t, source="undo")
+                stored = None
+            else:
+                stored = unit.put_tool(t, {k: v for k, v in before.items() if k != "t"}, source="undo",
+                                       detail={"undo_of": entry["id"]})
+            new_id = unit.audit(1, f"T{t}")[0]["id"]
+        if stored is not None:
+            self._stored(stored)
+        return {"undone": entry["id"], "audit_id": new_id, "kind": "tool", "offset": f"T{t}", "value": stored}
+
+    def put_field(self, t: int, field: str, text: str, source: str = "screen") -> dict:
         """One table cell from the screen (``length``, ``wear.radius``, ``type``, ``name``)."""
         if field not in TOOL_FIELDS:
             raise InvalidInput(f"{field}: unknown field", field=field)
+        value: str | float | None
         if field == "name":
             value = text.strip() or None
         else:
@@ -93,9 +106,9 @@ class ToolService:
                 number = float(text.strip().replace(",", "."))
             except ValueError:
                 raise InvalidInput(f"{field}: {text!r} is not a number", field=field) from None
-            value = int(number) if field == "type" and number.is_integer() else number
+            value = int(number) if field in ("type", "sl") and number.is_integer() else number
         part, _, sub = field.partition(".")
-        return self.put(t, {part: {sub: value}} if sub else {part: value})
+        return self.put(t, {part: {sub: value}} if sub else {part: value}, source=source)
 
     def delete(self, t: int) -> None:
         t = self.check_number(t)
@@ -103,6 +116,6 @@ class ToolService:
             raise ConflictError(f"T{t} is in the spindle; change the tool first", code="tool_in_spindle")
         with self._db.unit() as unit:
             try:
-                unit.delete_tool(t)
+                unit.delete_tool(t, source="api")
             except KeyError:
                 raise NotFoundError(f"T{t} is not in the tool table", code="unknown_tool") from None

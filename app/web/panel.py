@@ -6,14 +6,17 @@ refused jog shows its reason without leaving the screen.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Annotated
 
 from fastapi import APIRouter, Form, Request
 
+from app.access.deps import needs
 from app.deps import MachineDep
 from app.errors import HmiError
-from app.services.machine_service import PanelState
+from app.services.machine_service import MAX_FEED
 
+from .panel_state import PanelState
 from .templating import render_block
 
 router = APIRouter()
@@ -24,69 +27,123 @@ def message(request: Request, text: str = "", level: str = "info", headers: dict
     return render_block(request, "base.html", "message", {"message": text, "level": level}, headers=headers)
 
 
-@router.get("/ui/header")
+@router.get("/ui/header", name="panel_header")
 def header(request: Request):
     return render_block(request, "base.html", "header_status")
 
 
-@router.get("/ui/position")
+@router.get("/ui/position", name="panel_position")
 def position(request: Request):
     return render_block(request, "base.html", "position_values")
 
 
-@router.post("/ui/panel/coords")
+def _panel(request: Request, machine, **chosen) -> PanelState:
+    """The tab's panel (headers), with the value a selection key just chose."""
+    panel = PanelState.of(request, machine.axes)
+    return replace(panel, **{k: v for k, v in chosen.items() if v is not None})
+
+
+@router.post("/ui/panel/coords", name="panel_coords", dependencies=[needs("view")])
 def set_coords(request: Request, machine: MachineDep, coords: Annotated[str, Form()]):
-    if coords in ("WCS", "MCS"):
-        machine.panel.coords = coords
-    return render_block(request, "base.html", "position")
+    panel = _panel(request, machine, coords=coords if coords in ("WCS", "MCS") else None)
+    return render_block(request, "base.html", "position", {"panel": panel})
 
 
-@router.post("/ui/panel/axis")
+@router.post("/ui/panel/axis", name="panel_axis", dependencies=[needs("jog")])
 def set_axis(request: Request, machine: MachineDep, axis: Annotated[str, Form()]):
-    if axis in machine.axes:
-        machine.panel.axis = axis
-    return render_block(request, "base.html", "mcp")
+    panel = _panel(request, machine, axis=axis if axis in machine.axes else None)
+    return render_block(request, "base.html", "mcp", {"panel": panel})
 
 
-@router.post("/ui/panel/increment")
+@router.post("/ui/panel/increment", name="panel_increment", dependencies=[needs("jog")])
 def set_increment(request: Request, machine: MachineDep, increment: Annotated[str, Form()]):
-    if increment in PanelState.INCREMENTS:
-        machine.panel.increment = increment
-    return render_block(request, "base.html", "mcp")
+    panel = _panel(request, machine, increment=increment if increment in PanelState.INCREMENTS else None)
+    return render_block(request, "base.html", "mcp", {"panel": panel})
 
 
-@router.post("/ui/jog")
-def jog(request: Request, machine: MachineDep, direction: Annotated[str, Form()]):
-    """One increment of the selected axis (blocks until the move ends, like the API)."""
-    step = PanelState.INCREMENTS.get(machine.panel.increment)
+def _jog_feed(request: Request, machine, rapid: str | None = None) -> float | None:
+    """The tab's jog feed (mm/min): its feed choice, or RAPID times the rapid override; None:
+    the machine's own jog feed."""
+    panel = PanelState.of(request, machine.axes)
+    traverse = getattr(getattr(machine.scenario, "machine", None), "rapid", 10000.0)
+    feed = panel.jog_feed(traverse, None if rapid is None else rapid == "on")
+    return None if feed is None else min(feed, MAX_FEED)
+
+
+def _jog_axis(request: Request, machine, axis: str | None) -> str:
+    """The axis the command names (the tab's selection), never another tab's."""
+    return axis if axis is not None and axis in machine.axes else PanelState.of(request, machine.axes).axis
+
+
+@router.post("/ui/jog", name="panel_jog", dependencies=[needs("jog")])
+def jog(request: Request, machine: MachineDep, direction: Annotated[str, Form()],
+        axis: Annotated[str | None, Form()] = None, increment: Annotated[str | None, Form()] = None):
+    """One increment of the tab's axis (blocks until the move ends, like the API)."""
+    step = PanelState.INCREMENTS.get(increment or PanelState.of(request, machine.axes).increment)
     if direction not in DIRECTIONS or step is None:
         return message(request, "Select an increment (INC) for a single jog step", "error")
     try:
-        machine.jog(machine.panel.axis, DIRECTIONS[direction] * step)
+        machine.jog(_jog_axis(request, machine, axis), DIRECTIONS[direction] * step, _jog_feed(request, machine))
     except HmiError as exc:
         return message(request, exc.message, "error")
     return message(request)
 
 
-@router.post("/ui/jog/start")
-def jog_start(request: Request, machine: MachineDep, direction: Annotated[str, Form()]):
-    """Press-and-hold: continuous jog until ``/ui/jog/stop`` (key released)."""
+@router.post("/ui/panel/jogfeed", name="panel_jog_feed", dependencies=[needs("jog")])
+def set_jog_feed(request: Request, machine: MachineDep, feed: Annotated[str | None, Form()] = None,
+                 rapid: Annotated[str | None, Form()] = None, rov: Annotated[str | None, Form()] = None):
+    """The tab's jog feed, RAPID key and rapid override (kept by the tab, like axis and increment)."""
+    panel = _panel(request, machine, feed=feed if feed in PanelState.FEEDS else None,
+                   rov=rov if rov in PanelState.RAPID_OVERRIDES else None,
+                   rapid=None if rapid not in ("on", "off") else rapid == "on")
+    return render_block(request, "base.html", "mcp", {"panel": panel})
+
+
+HANDWHEEL_MAX_DETENTS = 1000      # one request: at most 10 turns of a 100-detent wheel
+
+
+@router.post("/ui/handwheel", name="panel_handwheel", dependencies=[needs("jog")])
+def handwheel(request: Request, machine: MachineDep, detents: Annotated[str, Form()],
+              axis: Annotated[str | None, Form()] = None, increment: Annotated[str | None, Form()] = None):
+    """The virtual handwheel: ``detents`` (signed) times the tab's increment on its axis, at the jog feed."""
+    step = PanelState.INCREMENTS.get(increment or PanelState.of(request, machine.axes).increment)
+    try:
+        count = int(detents)
+    except ValueError:
+        return message(request, "Handwheel: the number of detents must be a whole number", "error")
+    if step is None:
+        return message(request, "Handwheel: select an increment (INC 1 … 1000) for the distance per detent", "error")
+    if count == 0 or abs(count) > HANDWHEEL_MAX_DETENTS:
+        return message(request, f"Handwheel: 1 to {HANDWHEEL_MAX_DETENTS} detents at a time", "error")
+    try:
+        machine.jog(_jog_axis(request, machine, axis), count * step, _jog_feed(request, machine))
+    except HmiError as exc:
+        return message(request, exc.message, "error")
+    return message(request)
+
+
+@router.post("/ui/jog/start", name="panel_jog_start", dependencies=[needs("jog")])
+def jog_start(request: Request, machine: MachineDep, direction: Annotated[str, Form()],
+              axis: Annotated[str | None, Form()] = None, rapid: Annotated[str | None, Form()] = None):
+    """Press-and-hold: starts or renews the continuous jog (hold-to-run: the tab renews it while
+    the key is held; without a renewal the axis stops after 0.5 s, design.md §9.1)."""
     if direction not in DIRECTIONS:
         return message(request, "direction must be + or -", "error")
     try:
-        machine.jog_continuous(machine.panel.axis, DIRECTIONS[direction])
+        machine.jog_continuous(_jog_axis(request, machine, axis), DIRECTIONS[direction],
+                               _jog_feed(request, machine, rapid))
     except HmiError as exc:
         return message(request, exc.message, "error")
     return message(request)
 
 
-@router.post("/ui/jog/stop")
+@router.post("/ui/jog/stop", name="panel_jog_stop", dependencies=[needs("view")])
 def jog_stop(request: Request, machine: MachineDep):
-    machine.stop()
+    machine.stop_jog()
     return message(request)
 
 
-@router.post("/ui/override")
+@router.post("/ui/override", name="panel_override", dependencies=[needs("jog")])
 def override(request: Request, machine: MachineDep, feed: Annotated[str, Form()]):
     try:
         machine.set_override(float(feed))
@@ -95,14 +152,14 @@ def override(request: Request, machine: MachineDep, feed: Annotated[str, Form()]
     return message(request)
 
 
-@router.post("/ui/reset")
+@router.post("/ui/reset", name="panel_reset", dependencies=[needs("view")])
 def reset(request: Request, machine: MachineDep):
     machine.reset()
-    # screens listen with hx-trigger="hmi-reset from:body" (spec §1.4: Reset aborts measuring)
+    # screens listen with hx-trigger="hmi-reset from:body" (jog-measuring §1.4: Reset aborts measuring)
     return message(request, headers={"HX-Trigger": "hmi-reset"})
 
 
-@router.post("/ui/ncstart")
+@router.post("/ui/ncstart", name="panel_nc_start", dependencies=[needs("measure")])
 def nc_start(request: Request):
     """NC Start outside a measuring input screen: no function (the JOG basic screen)."""
     return message(request, "NC Start: no measuring function selected", "info")

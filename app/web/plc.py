@@ -1,5 +1,5 @@
-"""PLC test page ``/plc``: DB19.DBB43 as LEDs with toggles for bits 0..3 (spec §3.2) and the
-readiness checklist (spec §1.6 [I]). Both parts refresh by htmx polling."""
+"""PLC test page ``/plc``: DB19.DBB43 as LEDs with toggles for bits 0..3 (jog-measuring §3.2) and the
+readiness checklist (jog-measuring §1.6 [I]). Both parts refresh by htmx polling."""
 
 from __future__ import annotations
 
@@ -7,7 +7,8 @@ from typing import Annotated
 
 from fastapi import APIRouter, Form, Request
 
-from app.deps import ServicesDep
+from app.access.deps import needs
+from app.deps import PlcDep, ServicesDep
 from app.errors import HmiError
 from app.services.plc import MEANINGS
 from app.services.readiness import ReadinessService
@@ -25,33 +26,34 @@ def _readiness_ctx(services) -> dict:
     return {"readiness": ReadinessService(services).report()}
 
 
-@router.get("/plc")
+@router.get("/plc", name="plc_screen")
 def plc_screen(request: Request, services: ServicesDep):
     return render_screen(request, "plc.html", {"screen": "plc", **_byte_ctx(services), **_readiness_ctx(services)})
 
 
-@router.get("/plc/db19")
+@router.get("/plc/db19", name="plc_db19")
 def plc_byte(request: Request, services: ServicesDep):
     return render_block(request, "plc.html", "plc_byte", _byte_ctx(services))
 
 
-@router.post("/plc/db19/bit")
-def plc_toggle(request: Request, services: ServicesDep, bit: Annotated[str, Form()],
+@router.post("/plc/db19/bit", name="plc_db19_bit", dependencies=[needs("measure")])
+def plc_toggle(request: Request, services: ServicesDep, plc: PlcDep, bit: Annotated[str, Form()],
                value: Annotated[str, Form()]):
     try:
         number = int(bit) if bit.strip().lstrip("-").isdigit() else bit
-        services.plc.write(number, value == "1")
+        plc.write(number, value == "1")
     except HmiError as exc:
         return render_block(request, "plc.html", "plc_byte", _byte_ctx(services, exc.message, "error"))
     return render_block(request, "plc.html", "plc_byte", _byte_ctx(services))
 
 
-@router.post("/plc/db19/mode")
-def plc_mode(request: Request, services: ServicesDep, auto_release: Annotated[str | None, Form()] = None):
-    services.plc.set_auto_release(auto_release in ("on", "true", "1"))
+@router.post("/plc/db19/mode", name="plc_db19_mode", dependencies=[needs("settings")])
+def plc_mode(request: Request, services: ServicesDep, plc: PlcDep,
+             auto_release: Annotated[str | None, Form()] = None):
+    plc.set_auto_release(auto_release in ("on", "true", "1"))
     return render_block(request, "plc.html", "plc_byte", _byte_ctx(services))
 
 
-@router.get("/plc/readiness")
+@router.get("/plc/readiness", name="plc_readiness")
 def readiness_block(request: Request, services: ServicesDep):
     return render_block(request, "plc.html", "readiness", _readiness_ctx(services))

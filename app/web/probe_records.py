@@ -14,8 +14,10 @@ from fastapi import Request
 from pydantic import ValidationError
 
 from app.errors import HmiError
+from app.i18n import _
 from app.services.settings import validation_errors
 
+from . import units
 from .templating import fixed
 
 DECIMALS = 4          # mm values of a record on the screen (the ``ui.record_field`` default)
@@ -29,6 +31,15 @@ def shown(value) -> str:
 def number(text, name: str, errors: dict, stored=None) -> float | None:
     """Typed text -> mm (None when empty); the untouched display text of ``stored`` keeps its
     full precision, so saving without editing changes nothing."""
+    gud = units.current()
+    if gud is not None:                 # a screen form: typed in the screen's unit (app/web/units.py)
+        if str(text or "").strip() == "":
+            return None
+        try:
+            return units.parse_length(text, gud, stored)
+        except units.NumberError:
+            errors[name] = _("Enter a number")
+            return None
     text = str(text or "").strip().replace(",", ".")
     if text == "":
         return None
@@ -76,7 +87,8 @@ async def save(request: Request, service, n: int, parse_form: Callable, screen: 
     except HmiError as exc:
         return screen(level="error", message=exc.message)
     form = await request.form()
-    record, errors = parse_form(form, stored_or_new(service, n))
+    with units.typed_in(request.app.state.services.settings.get()):
+        record, errors = parse_form(form, stored_or_new(service, n))
     if not errors:
         try:
             service.model.model_validate(record)
@@ -85,10 +97,10 @@ async def save(request: Request, service, n: int, parse_form: Callable, screen: 
     texts = {k: str(v) for k, v in form.items()}
     if errors:
         return screen(n, record=record, errors=errors, texts=texts, level="error",
-                      message=f"Not saved: {len(errors)} field(s) need correction")
+                      message=_("Not saved: %(n)s field(s) need correction", n=len(errors)))
     try:
-        saved = service.put(n, record)
+        saved = service.put(n, record, source="screen")
     except HmiError as exc:
         return screen(n, record=record, errors={exc.field or "form": exc.message}, texts=texts,
                       level="error", message=exc.message)
-    return screen(n, record=saved, message=f"{service.what.capitalize()} {n} saved")
+    return screen(n, record=saved, message=_("%(what)s %(n)s saved", what=_(service.what).capitalize(), n=n))

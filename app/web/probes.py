@@ -1,4 +1,4 @@
-"""Workpiece probe data screen (_WP[k], spec/jog-measuring.md §5, §8.4): the records, and one
+"""Workpiece probe data screen (_WP[k], spec/jog-measuring.md §5, jog-measuring §8.4): the records, and one
 record's ball diameter, effective diameter, trigger values per travel direction, skew, length
 convention and how it was calibrated (when, feed, override, gauge, tool). Editable with
 validation (the same rules as ``PUT /api/probes/{n}``); the calibration itself is
@@ -11,7 +11,10 @@ from functools import partial
 
 from fastapi import APIRouter, Request
 
+from app.access.deps import needs
 from app.deps import MachineDep, ProbesDep, SettingsDep
+from app.errors import HmiError
+from app.services.lathe_data import GrooveService
 from app.services.measuring import probe_number_for
 
 from . import probe_records
@@ -24,15 +27,19 @@ router = APIRouter()
 TRIGGERS = [("X-", 1, "travel −X (abscissa minus)"), ("X+", 2, "travel +X (abscissa plus)"),
             ("Y-", 3, "travel −Y (ordinate minus)"), ("Y+", 4, "travel +Y (ordinate plus)"),
             ("Z-", 5, "travel −Z (infeed minus)")]
+# a lathe's _WP[k] (turning.md §0.7): trigger values per travel direction, radius values, G18
+LATHE_TRIGGERS = [("Z-", 1, "travel −Z (abscissa minus)"), ("Z+", 2, "travel +Z (abscissa plus)"),
+                  ("X-", 3, "travel −X (ordinate minus)"), ("X+", 4, "travel +X (ordinate plus)")]
 
 
-def parse_form(form, stored: dict) -> tuple[dict, dict[str, str]]:
+def parse_form(form, stored: dict, lathe: bool = False) -> tuple[dict, dict[str, str]]:
     """Form -> record (the stored record with the edited fields), {field: error}."""
     errors: dict[str, str] = {}
     old = stored.get("trigger") or {}
-    edited = {key for key, _index, _text in TRIGGERS}
+    triggers = LATHE_TRIGGERS if lathe else TRIGGERS
+    edited = {key for key, _index, _text in triggers}
     trigger = {k: v for k, v in old.items() if k not in edited}
-    for key, _index, _text in TRIGGERS:
+    for key, _index, _text in triggers:
         value = number(form.get(f"trigger.{key}", ""), f"trigger.{key}", errors, old.get(key))
         if value is not None:
             trigger[key] = value
@@ -43,12 +50,20 @@ def parse_form(form, stored: dict) -> tuple[dict, dict[str, str]]:
             if value is None and name == "ball_diameter":
                 errors[name] = "required"
             record[name] = 0.0 if value is None else value
-    skew = []
-    for i, axis in enumerate("XY"):
-        old = (stored.get("skew") or [0.0, 0.0])[i]
-        value = number(form.get(f"skew.{axis}", ""), f"skew.{axis}", errors, old)
-        skew.append(old if value is None else value)
-    record["skew"] = skew
+    if lathe:                                    # _WP[k,7]/[8]: position deviation Z, X
+        deviation = dict(stored.get("position_deviation") or {})
+        for axis in "ZX":
+            value = number(form.get(f"position_deviation.{axis}", ""), f"position_deviation.{axis}", errors,
+                           deviation.get(axis))
+            deviation[axis] = deviation.get(axis, 0.0) if value is None else value
+        record["position_deviation"] = deviation
+    else:
+        skew = []
+        for i, axis in enumerate("XY"):
+            old = (stored.get("skew") or [0.0, 0.0])[i]
+            value = number(form.get(f"skew.{axis}", ""), f"skew.{axis}", errors, old)
+            skew.append(old if value is None else value)
+        record["skew"] = skew
     tool_text = str(form.get("tool", "")).strip()
     if tool_text == "":
         record["tool"] = None
@@ -57,7 +72,7 @@ def parse_form(form, stored: dict) -> tuple[dict, dict[str, str]]:
             record["tool"] = int(tool_text)
         except ValueError:
             errors["tool"] = f"{tool_text!r} is not a tool number"
-    for axis in "XY":
+    for axis in ("ZX" if lathe else "XY"):
         plus, minus = trigger.get(f"{axis}+"), trigger.get(f"{axis}-")
         if plus is not None and plus >= 0:
             errors[f"trigger.{axis}+"] = (f"must be negative: travel +{axis} switches with "
@@ -65,6 +80,8 @@ def parse_form(form, stored: dict) -> tuple[dict, dict[str, str]]:
         if minus is not None and minus <= 0:
             errors[f"trigger.{axis}-"] = (f"must be positive: travel −{axis} switches with "
                                             "the ball centre past the wall")
+    if record.get("lobing") and any(record.get(k) != stored.get(k) for k in ("trigger", "effective_diameter", "skew")):
+        record["lobing"] = None          # the calibrated trigger map no longer agrees with typed values
     return record, errors
 
 
@@ -77,19 +94,59 @@ def _screen(request: Request, probes, settings, machine, n: int | None = None, r
     n = active if n is None else n
     if record is None:
         record = probe_records.stored_or_new(probes, n)
+    lathe = machine.is_lathe
+    extra = _lathe_context(request, record) if lathe else {}
     return render_screen(request, "probes.html", {
         "screen": "probes", "n": n, "active": active, "spindle": spindle,
-        "records": records, "record": record, "triggers": TRIGGERS, "errors": errors or {},
-        "texts": texts or {}, "message": message, "level": level,
-        "length_to_tip_gud": bool(settings.get().length_to_tip)})
+        "records": records, "record": record, "triggers": LATHE_TRIGGERS if lathe else TRIGGERS,
+        "errors": errors or {}, "texts": texts or {}, "message": message, "level": level,
+        "length_to_tip_gud": bool(settings.get().length_to_tip), **extra})
 
 
-@router.get("/probes")
+def _lathe_context(request: Request, record: dict) -> dict:
+    """The lathe probe's tool data (L1, L2, SL, R) and the reference grooves _KB."""
+    services = request.app.state.services
+    tool = None
+    if record.get("tool"):
+        try:
+            tool = services.tools.get(int(record["tool"]))
+        except HmiError:
+            tool = None
+    return {"lathe_probe_tool": tool, "grooves": GrooveService(services.db).list(), "groove_keys": GROOVE_FIELDS}
+
+
+GROOVE_FIELDS = [("x_minus", "SL 7: wall −X side", "_KB[k,1]"), ("x_plus", "SL 7: wall +X side", "_KB[k,0]"),
+                 ("bottom_z", "SL 7: bottom Z", "_KB[k,2]"), ("z_minus", "SL 8: wall −Z side", "_KB[k,4]"),
+                 ("z_plus", "SL 8: wall +Z side", "_KB[k,3]"), ("top_x", "SL 8: upper edge X", "_KB[k,5]"),
+                 ("bottom_x", "SL 8: bottom X", "_KB[k,6]")]
+
+
+@router.get("/probes", name="probes_screen")
 def probes_screen(request: Request, probes: ProbesDep, settings: SettingsDep, machine: MachineDep):
     return probe_records.show(request, probes, partial(_screen, request, probes, settings, machine))
 
 
-@router.post("/probes/{n}")
+@router.post("/probes/{n}", name="probes_save", dependencies=[needs("probe_data")])
 async def save_probe(request: Request, n: int, probes: ProbesDep, settings: SettingsDep, machine: MachineDep):
-    return await probe_records.save(request, probes, n, parse_form,
+    return await probe_records.save(request, probes, n, partial(parse_form, lathe=machine.is_lathe),
                                     partial(_screen, request, probes, settings, machine))
+
+
+@router.post("/probes/grooves/{k}", name="probes_groove_save", dependencies=[needs("probe_data")])
+async def save_groove(request: Request, k: int, probes: ProbesDep, settings: SettingsDep, machine: MachineDep):
+    """A reference groove record _KB[k−1] as entered (machine-related radius values, turning.md §0.6)."""
+    form = await request.form()
+    values: dict[str, float] = {}
+    errors: dict[str, str] = {}
+    for key, _label, _gud in GROOVE_FIELDS:
+        value = number(form.get(f"groove.{key}", ""), f"groove.{key}", errors)
+        if value is not None and value != 0.0:
+            values[key] = value
+    screen = partial(_screen, request, probes, settings, machine)
+    if errors:
+        return screen(level="error", message=f"Groove {k} not saved: " + "; ".join(errors.values()))
+    try:
+        GrooveService(request.app.state.services.db).put(k, values)
+    except HmiError as exc:
+        return screen(level="error", message=exc.message)
+    return screen(message=f"Reference groove {k} saved")

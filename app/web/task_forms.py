@@ -1,167 +1,19 @@
-"""Declarative input fields of every measuring screen (spec/jog-measuring.md §2.3, design.md §4).
+"""Typed text of a measuring screen <-> API params (spec/jog-measuring.md §2.3, design.md §4).
 
-A field's ``name`` is the API parameter (``setpoint.X`` for one axis of a plane setpoint).
-Labels are the manual's English texts. Validation is the workflow's (``engine.plan``); this
-module only turns typed text into API params and back.
+The fields themselves are declared per task in ``app.workflow.forms`` (named by the task
+registry); validation is the engine's. This module only turns typed text into API params and
+back, and puts the workflow's messages next to the field they name. Lengths (unit "mm") are
+typed and shown in the screen's unit (``app.web.units``); the params are always mm.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from engine.planes import Plane
-
-WORKPIECE_FAMILIES = ("edge", "corner", "pocket", "hole", "spigot", "plane")
-MEASURE_ONLY = "measure_only"
-
-
-@dataclass(frozen=True)
-class FieldSpec:
-    name: str                       # API param; "setpoint.X" = one axis of the setpoint object
-    label: str                      # the manual's English text
-    kind: str = "number"            # number | choice | position
-    unit: str = ""
-    default: str = ""
-    choices: tuple[tuple[str, str], ...] = ()   # (value, text)
-    locks: bool = False             # decides how the points are probed: locked while one is stored
-
-
-@dataclass(frozen=True)
-class FormEnv:
-    """What the fields depend on at run time."""
-
-    plane: Plane
-    offsets: tuple[str, ...]        # stored frames in chain order
-    active_offset: str
-    rotary_axes: tuple[str, ...]
-    gud: object                     # app.gud.GudSettings
-
-    @property
-    def extended(self) -> bool:
-        return getattr(self.gud, "compensation_choice", "standard") == "extended"
-
-
-def is_workpiece(task: str) -> bool:
-    return task.split(".")[0] in WORKPIECE_FAMILIES
-
-
-def target_choices(env: FormEnv) -> tuple[tuple[str, str], ...]:
-    """Measure only, G54.. and G505.., Basic reference, basic frames (extended choice, spec §4.1/4.2)."""
-    out = [(MEASURE_ONLY, "Measure only")]
-    out += [(n, n) for n in env.offsets if n.startswith("G")]
-    if "BASIC_REF" in env.offsets:
-        out.append(("BASIC_REF", "Basic reference"))
-    if env.extended:
-        out += [(n, f"Basic frame {n.split('_')[1]}") for n in env.offsets
-                if n.startswith("BASIC_") and n != "BASIC_REF"]
-    return tuple(out)
-
-
-def default_target(env: FormEnv) -> str:
-    """Preset to the WO active during measurement (manual §4.3.9); G500 = measure only."""
-    return env.active_offset if env.active_offset in env.offsets else MEASURE_ONLY
-
-
-def _target(env: FormEnv) -> FieldSpec:
-    return FieldSpec("target", "Zero offset", "choice", default=default_target(env), choices=target_choices(env))
-
-
-def _axis_field(env: FormEnv, default: str, label: str = "Axis") -> FieldSpec:
-    return FieldSpec("axis", label, "choice", default=default, choices=tuple((a, a) for a in env.plane.axes),
-                     locks=True)
-
-
-def _direction(name: str = "direction", label: str = "Direction", default: str = "+") -> FieldSpec:
-    return FieldSpec(name, label, "choice", default=default, choices=(("+", "+"), ("-", "−")), locks=True)
-
-
-def _plane_setpoints(env: FormEnv, of: str = "P0") -> list[FieldSpec]:
-    return [FieldSpec(f"setpoint.{a}", f"Setpoint {a}0 ({of})", unit="mm", default="0")
-            for a in (env.plane.first, env.plane.second)]
-
-
-def _angle_correction(env: FormEnv, allow_none: bool) -> FieldSpec:
-    choices = ((("none", "none"),) if allow_none else ()) + (("rotation", "Coordinate rotation"),)
-    choices += tuple((a, f"Rotary axis {a}") for a in env.rotary_axes)
-    return FieldSpec("angle_correction", "Angle correction", "choice",
-                     default="none" if allow_none else "rotation", choices=choices)
-
-
-def _setpoint_angle() -> FieldSpec:
-    return FieldSpec("setpoint_angle", "Setpoint angle", unit="°", default="0")
-
-
-def _diameter() -> FieldSpec:
-    # a hole's diameter may stay empty: probing then starts at the start point (spec §2.3)
-    return FieldSpec("diameter", "Approx. diameter", unit="mm", locks=True)
-
-
-def _infeed() -> FieldSpec:
-    return FieldSpec("infeed", "Infeed DZ", unit="mm", locks=True)
-
-
-def fields_for(task: str, env: FormEnv) -> list[FieldSpec]:
-    """The input fields of ``task`` in screen order."""
-    family, _, variant = task.partition(".")
-    plane = env.plane
-    if family == "edge":
-        out = [_target(env), _axis_field(env, plane.second if variant == "align" else plane.first)]
-        if variant == "align":
-            out += [_direction(),
-                    FieldSpec("reference_axis", "Angle reference axis", "choice", default=plane.first,
-                              choices=((plane.first, plane.first), (plane.second, plane.second)), locks=True),
-                    _angle_correction(env, False), _setpoint_angle()]
-        elif variant == "distance":
-            out += [_direction(label="Direction P1"), _direction("direction_p2", "Direction P2", "-"),
-                    FieldSpec("setpoint", "Setpoint of the centre", unit="mm", default="0")]
-        else:
-            out += [_direction(), FieldSpec("setpoint", "Setpoint", unit="mm", default="0")]
-        return out
-    if family == "corner":
-        return [_target(env),
-                FieldSpec("kind", "Inside / outside corner", "choice", default="outside",
-                          choices=(("outside", "Outside corner"), ("inside", "Inside corner")), locks=True),
-                FieldSpec("position", "Corner position", "position", default="1",
-                          choices=tuple((str(n), str(n)) for n in range(1, 5)), locks=True),
-                *_plane_setpoints(env)]
-    if task in ("pocket.rect", "spigot.rect"):
-        out = [_target(env), FieldSpec("length", f"Length L ({plane.first})", unit="mm", locks=True),
-               FieldSpec("width", f"Width W ({plane.second})", unit="mm", locks=True)]
-        if family == "spigot":
-            out.append(_infeed())
-        return out + _plane_setpoints(env)
-    if family in ("hole", "spigot"):
-        spigot = family == "spigot"
-        out = [_target(env), _diameter()]
-        if spigot:
-            out.append(_infeed())
-        if variant == "1":
-            out.append(FieldSpec("probe_angle", "Probing angle", unit="°", default="0", locks=True))
-            return out + _plane_setpoints(env)
-        out += [_angle_correction(env, variant != "2"), _setpoint_angle()]
-        if variant == "2":
-            out.append(FieldSpec("set_p1", "Set P1", "choice", default="no", choices=(("no", "No"), ("yes", "Yes"))))
-            return out + _plane_setpoints(env, "P1")
-        return out + _plane_setpoints(env)
-    if family == "plane":
-        return [_target(env)]
-    if task == "probe.length":
-        return [FieldSpec("setpoint", f"Calibration height {plane.infeed}", unit="mm",
-                          default=_number_text(getattr(env.gud, "cal_height", 0.0)))]
-    if task == "probe.radius":
-        ring = float(getattr(env.gud, "cal_ring_diameter", 0.0) or 0.0)
-        return [FieldSpec("diameter", "Diameter of calibration ring", unit="mm",
-                          default=_number_text(ring) if ring > 0 else "")]
-    if task == "toolprobe.calibrate":
-        return [FieldSpec("mode", "Calibration type (Select)", "choice", default="length",
-                          choices=(("length", "Length only"), ("length_diameter", "Length and diameter")))]
-    if family == "tool":
-        return [FieldSpec("offset_v", "Offset V", unit="mm", default="0")]
-    return []
-
-
-def _number_text(value: float) -> str:
-    return f"{float(value):g}"
+from app.web import units
+from app.web.texts import label_text, translate_message
+from app.workflow.forms import LATHE_TOOL_TARGET, TOOL_TARGET, FieldSpec, number_text
+from app.workflow.tasks import Category, TaskSpec
 
 
 @dataclass
@@ -170,30 +22,74 @@ class FormData:
 
     values: dict[str, str]
     params: dict
-    target: str | None
+    target: str | dict | None                 # a dict: the tool target's fields (tool offsets)
     errors: dict[str, str] = field(default_factory=dict)
 
 
-def defaults(fields: list[FieldSpec]) -> dict[str, str]:
-    return {f.name: f.default for f in fields}
+def _mm_default(spec: FieldSpec) -> float | None:
+    """The default of a length field as mm (defaults are written in mm)."""
+    if spec.unit != "mm" or spec.default == "":
+        return None
+    try:
+        return float(spec.default)
+    except ValueError:
+        return None
 
 
-def form_data(task: str, fields: list[FieldSpec], form: dict | None, gud=None) -> FormData:
-    """API params from the typed text; empty numbers are left out (the workflow's defaults apply)."""
-    values = defaults(fields)
+def defaults(fields: list[FieldSpec], gud=None) -> dict[str, str]:
+    """The fields' default text, lengths in the screen's unit."""
+    out = {}
+    for f in fields:
+        mm = _mm_default(f) if gud is not None else None
+        out[f.name] = units.field_text(mm, gud) if mm is not None else f.default
+    return out
+
+
+def _number_value(spec: FieldSpec, text: str, gud, known: dict):
+    """Typed text of a number field -> the param: a length in mm (from the screen's unit), another
+    number as it is; text that is no number is passed on for the workflow to name the field."""
+    try:
+        if spec.unit == "mm" and gud is not None:
+            for candidate in (known.get(spec.name), _mm_default(spec)):
+                if candidate is not None and text in units.shown_texts(candidate, gud):
+                    return float(candidate)
+            return units.parse_length(text, gud)
+        return units.parse_number(text)
+    except units.NumberError:
+        return text.replace(",", ".")
+
+
+def form_data(task: TaskSpec, fields: list[FieldSpec], form: dict | None, gud=None,
+              known: dict | None = None) -> FormData:
+    """API params from the typed text; empty numbers are left out (the workflow's defaults apply).
+    ``known``: mm values the fields showed (a session's params), kept exactly when not edited."""
+    values = defaults(fields, gud)
+    known = known or {}
     if form:
         values.update({f.name: str(form[f.name]).strip() for f in fields if f.name in form})
+    if getattr(task, "lathe", False):
+        return _lathe_form_data(fields, values, gud)
     params: dict = {}
-    target = None
+    target: str | dict | None = None
+    tool: dict = {}
+    tolerance: dict = {}
     for spec in fields:
         text = values.get(spec.name, "")
         if spec.name == "target":
             target = text or None
             continue
+        if spec.group == "tool":          # the tool offset's fields (design.md §9.3 target object)
+            part, _, key = spec.name.partition(".")
+            if text != "":
+                typed = _typed_value(key, text)
+                if spec.unit == "mm" and isinstance(typed, float) and gud is not None:
+                    typed = _number_value(spec, text, gud, known)
+                (tool if part == "tool_target" else tolerance)[key] = typed
+            continue
         if spec.kind == "number":
             if text == "":
                 continue
-            value: object = text.replace(",", ".")
+            value: object = _number_value(spec, text, gud, known)
         elif spec.name == "set_p1":
             value = text == "yes"
         else:
@@ -202,16 +98,53 @@ def form_data(task: str, fields: list[FieldSpec], form: dict | None, gud=None) -
             params.setdefault("setpoint", {})[spec.name.split(".", 1)[1]] = value
         else:
             params[spec.name] = value
-    if task.startswith("tool.") and gud is not None:
+    if task.category == Category.TOOL_MEASURING and gud is not None:
         params["compensation"] = gud.tool_offset_mode     # _JM_B[0], shown read-only
+    if target == TOOL_TARGET:
+        target = tool                                     # the workflow names a missing or bad tool
+        params["tolerance"] = tolerance
     return FormData(values=values, params=params, target=target)
 
 
-def values_from_params(fields: list[FieldSpec], params: dict) -> dict[str, str]:
-    """Text of the locked fields from a session's normalised params."""
+def _typed_value(key: str, text: str):
+    """Typed text of a tool-offset field: yes/no, whole numbers, decimals (a comma is a point)."""
+    if text in ("yes", "no"):
+        return text == "yes"
+    if key in ("tool", "k", "evnum"):
+        return int(text) if text.lstrip("-").isdigit() else text
+    if key in ("correct", "mode"):
+        return text
+    try:
+        return float(text.replace(",", "."))
+    except ValueError:
+        return text
+
+
+def known_values(fields: list[FieldSpec], params: dict) -> dict[str, float]:
+    """The mm values of a session's params per length field (``setpoint.X`` included)."""
     out = {}
     for spec in fields:
-        if spec.name.startswith("setpoint."):
+        if spec.unit != "mm":
+            continue
+        if spec.name.startswith("setpoint"):
+            value = _setpoint_value(spec.name, params.get("setpoint"))
+        else:
+            value = params.get(spec.name)
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            out[spec.name] = float(value)
+    return out
+
+
+def values_from_params(fields: list[FieldSpec], params: dict, setpoints: bool = False, gud=None) -> dict[str, str]:
+    """Text of the fields from a session's normalised params (``setpoints``: also the setpoint
+    fields, e.g. to show a session again after a refresh); lengths in the screen's unit."""
+    out = {}
+    for spec in fields:
+        if spec.name.startswith("setpoint"):
+            if setpoints:
+                value = _setpoint_value(spec.name, params.get("setpoint"))
+                if value is not None:
+                    out[spec.name] = _text(spec, value, gud)
             continue
         value = params.get(spec.name)
         if value is None:
@@ -219,10 +152,24 @@ def values_from_params(fields: list[FieldSpec], params: dict) -> dict[str, str]:
         if isinstance(value, bool):
             out[spec.name] = "yes" if value else "no"
         elif isinstance(value, float):
-            out[spec.name] = _number_text(value)
+            out[spec.name] = _text(spec, value, gud)
         else:
             out[spec.name] = str(value)
     return out
+
+
+def _text(spec: FieldSpec, value: float, gud) -> str:
+    if spec.unit == "mm" and gud is not None:
+        return units.field_text(float(value), gud)
+    return number_text(float(value))
+
+
+def _setpoint_value(name: str, value) -> float | None:
+    """``setpoint.X`` of {"X": ..}, or the single value of a one-axis setpoint field."""
+    if isinstance(value, dict):
+        axis = name.partition(".")[2]
+        value = value.get(axis) if axis else (next(iter(value.values())) if len(value) == 1 else None)
+    return None if value is None else float(value)
 
 
 def field_of_error(fields: list[FieldSpec], name: str | None) -> str:
@@ -236,9 +183,89 @@ def field_of_error(fields: list[FieldSpec], name: str | None) -> str:
 
 
 def friendly(fields: list[FieldSpec], field_name: str, message: str) -> str:
-    """The workflow's message with the parameter name replaced by the field's label."""
-    first, _, rest = message.partition(" ")
+    """The workflow's message in the operator's words: the parameter key replaced by the field's
+    label (``app.web.texts``), in the screen's language."""
+    labels = {spec.name: label_text(spec.label) for spec in fields}
+
+    def label_of(key: str) -> str | None:
+        if key in labels:
+            return str(labels[key])
+        if key.startswith("setpoint") and "setpoint" in labels:
+            return str(labels["setpoint"])
+        if key.startswith("setpoint.") and f"setpoint.{key[9:]}" in labels:
+            return str(labels[f"setpoint.{key[9:]}"])
+        if key.startswith("tolerance.") or key.startswith("tool_target."):
+            return None
+        for prefix in ("tolerance.", "tool_target."):
+            if prefix + key in labels:
+                return str(labels[prefix + key])
+        return None
+
+    return translate_message(message, label_of)
+
+
+# --- the lathe tasks (turning.md §10.2): nested params by dotted names, yes/no booleans ---------------
+
+def _lathe_number(text: str):
+    text = text.replace(",", ".")
+    try:
+        number = float(text)
+    except ValueError:
+        return text                                  # the engine names the field and the bad text
+    return int(number) if number.is_integer() and "." not in text and "e" not in text.lower() else number
+
+
+def _lathe_form_data(fields: list[FieldSpec], values: dict[str, str], gud=None) -> FormData:
+    """The lathe task's params; ``target`` is one of them (a WO name, measure only, or the tool
+    object from the ``target.*`` fields)."""
+    params: dict = {}
+    target_choice = values.get("target")
     for spec in fields:
-        if spec.name == field_name and (first == spec.name or first.startswith(spec.name + ".")):
-            return f"{spec.label} {rest}"
-    return message
+        text = values.get(spec.name, "")
+        if spec.name == "target" or text == "":
+            continue
+        if spec.group == "tool" and target_choice != LATHE_TOOL_TARGET:
+            continue
+        if spec.kind == "choice" and text in ("yes", "no") and {v for v, _ in spec.choices} == {"yes", "no"}:
+            value: object = text == "yes"
+        elif spec.kind == "number" and spec.unit == "mm" and gud is not None:
+            value = _number_value(spec, text, gud, {})        # typed in the screen's unit, mm here
+        elif spec.kind == "number" or spec.name == "groove.number":
+            value = _lathe_number(text)
+        else:
+            value = text
+        node = params
+        *path, last = spec.name.split(".")
+        for key in path:
+            node = node.setdefault(key, {})
+        node[last] = value
+    if target_choice:
+        params["target"] = params.get("target", {}) if target_choice == LATHE_TOOL_TARGET else target_choice
+    return FormData(values=values, params=params, target=None)
+
+
+def lathe_values_from_params(fields: list[FieldSpec], params: dict, gud=None) -> dict[str, str]:
+    """The fields' text from a lathe session's params (a refresh or another tab shows them again)."""
+    out: dict[str, str] = {}
+    target = params.get("target")
+    if isinstance(target, dict):
+        out["target"] = LATHE_TOOL_TARGET
+    elif target is not None:
+        out["target"] = str(target)
+    for spec in fields:
+        if spec.name == "target":
+            continue
+        node: object = params
+        for key in spec.name.split("."):
+            node = node.get(key) if isinstance(node, dict) else None
+            if node is None:
+                break
+        if node is None:
+            continue
+        if isinstance(node, bool):
+            out[spec.name] = "yes" if node else "no"
+        elif isinstance(node, float):
+            out[spec.name] = _text(spec, node, gud)
+        elif not isinstance(node, dict):
+            out[spec.name] = str(node)
+    return out

@@ -1,4 +1,4 @@
-"""Input screens of every measuring task (spec/jog-measuring.md §2, §3; design.md §7).
+"""Input screens of every measuring task (spec/jog-measuring.md §2, jog-measuring §3; design.md §7).
 
 One template for all tasks. The form posts on NC Start (the MCP triggers ``ncstart`` on the
 element marked ``data-ncstart``); the session is created on the first NC Start and re-created
@@ -8,30 +8,37 @@ decide the probing are locked; setpoints and the target stay editable until Calc
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import numpy as np
 from fastapi import APIRouter, HTTPException, Request
 from starlette.concurrency import run_in_threadpool
 
+from app.access.deps import needs, require_measurement
+from app.errors import WorkflowError
+from app.i18n import N_, _
 from app.services.measuring import MeasuringEnv
 from app.workflow import planning
 from app.workflow.executor import StepExecutor
-from app.workflow.service import WorkflowError
+from app.workflow.forms import TOOL_TARGET, FieldSpec, FormEnv
+from app.workflow.tasks import Category, task_spec
+from engine.plan import ideal_path
+from engine.tasks import Family
 
-from . import measure
+from . import measure, task_help, units
+from .lathe_screens import lathe_correction_rows, lathe_result_rows, lathe_svgs, lathe_tool_info
 from .task_forms import (
-    FieldSpec,
-    FormEnv,
     field_of_error,
-    fields_for,
     form_data,
     friendly,
-    is_workpiece,
+    known_values,
+    lathe_values_from_params,
     values_from_params,
 )
 from .task_svg import draw
-from .templating import ANGLE_KEYS, fmt_result, is_htmx, render_block, render_blocks, render_screen
+from .templating import ANGLE_KEYS, fmt_result, is_htmx, render_block, render_blocks, render_screen, url_path
+from .texts import field_name
 
 router = APIRouter()
 TEMPLATE = "measure_task.html"
@@ -42,23 +49,39 @@ class TaskPage:
     task: str
     label: str
     path: tuple[str, ...]
-    url: str
-    back: tuple[str, str]       # (softkey text, parent menu url)
+    slugs: tuple[str, ...]                  # its place in the menu tree (``measure.menu_route``)
+    back: tuple[str, tuple[str, ...]]       # (softkey text, slugs of the parent menu)
+
+    def href(self, request: Request) -> str:
+        """The URL of the input screen."""
+        route, params = measure.menu_route(self.slugs)
+        return url_path(request, route, **params)
+
+    @property
+    def url(self) -> str:
+        """The URL without a request: the route's path in the screens' router (mounted at the root)."""
+        route, params = measure.menu_route(self.slugs)
+        return str(measure.router.url_path_for(route, **params))
 
 
 def _pages() -> dict[str, TaskPage]:
     pages = {}
 
-    def walk(menu, base, path, back):
+    def walk(menu, slugs, path):
         for item in menu.items:
             if isinstance(item, measure.Menu):
-                walk(item, f"{base}/{item.slug}", (*path, item.label), f"{base}/{item.slug}")
+                walk(item, (*slugs, item.slug), (*path, item.label))
             else:
-                pages[item.task] = TaskPage(item.task, item.label, (*path, item.label), f"{base}/{item.slug}",
-                                            ("<< Back" if base.startswith("/measure/tool") else "Back", back))
+                back = "<< Back" if slugs[0] == measure.TOOL_MENU.slug else "Back"
+                pages[item.task] = TaskPage(item.task, item.label, (*path, item.label), (*slugs, item.slug),
+                                            (back, slugs))
 
-    walk(measure.WORKPIECE_MENU, "/measure/workpiece", (measure.WORKPIECE_MENU.label,), "/measure/workpiece")
-    walk(measure.TOOL_MENU, "/measure/tool", (measure.TOOL_MENU.label,), "/measure/tool")
+    walk(measure.WORKPIECE_MENU, (measure.WORKPIECE_MENU.slug,), (measure.WORKPIECE_MENU.label,))
+    walk(measure.TOOL_MENU, (measure.TOOL_MENU.slug,), (measure.TOOL_MENU.label,))
+    lathe = measure.LATHE_MENU
+    for item in lathe.items:
+        pages[item.task] = TaskPage(item.task, item.label, (lathe.label, item.label), (lathe.slug, item.slug),
+                                    ("<< Back", (lathe.slug,)))
     return pages
 
 
@@ -79,13 +102,15 @@ class _Env:
 
     def __init__(self, request: Request):
         services = request.app.state.services
+        self.request = request
         self.services = services
         self.workflow = services.workflow
         self.machine = services.machine
         self.gud = services.settings.get()
         self.form_env = FormEnv(plane=self.machine.plane(), offsets=tuple(services.offsets.names()),
                                 active_offset=self.machine.active_offset,
-                                rotary_axes=tuple(self.machine.rotary_axes), gud=self.gud)
+                                rotary_axes=tuple(self.machine.rotary_axes), gud=self.gud,
+                                diameter_programming=self.machine.diameter_programming)
 
     def session_of(self, task: str):
         session = self.workflow.session
@@ -100,17 +125,43 @@ def _stored_any(session) -> bool:
     return session is not None and any(s.stored for s in session.slots)
 
 
-def _locked_values(fields: list[FieldSpec], session) -> dict[str, str]:
+def _locked_values(fields: list[FieldSpec], session, gud=None) -> dict[str, str]:
     locked = [f for f in fields if f.locks]
-    return values_from_params(locked, session.params) if _stored_any(session) else {}
+    return values_from_params(locked, session.params, gud=gud) if _stored_any(session) else {}
 
 
 def _typed(env: _Env, task: str, form: dict | None):
-    """(fields, the task's session, FormData): the typed text, the locked fields from the session."""
-    fields = fields_for(task, env.form_env)
+    """(fields, the task's session, FormData): the typed text, the locked fields from the session.
+
+    Without a form (a GET: the screen opened again, a refresh, another tab) the session's own
+    params are shown: the server's session is the truth (design.md §9.1)."""
+    spec = task_spec(task)
+    fields = spec.form(env.form_env)
     session = env.session_of(task)
-    typed = {**(form or {}), **_locked_values(fields, session)}
-    return fields, session, form_data(task, fields, typed, env.gud)
+    if form is None and session is not None and spec.lathe:
+        form = lathe_values_from_params(fields, session.params, env.gud)
+    elif form is None and session is not None:
+        form = values_from_params(fields, session.params, setpoints=True, gud=env.gud)
+        if isinstance(session.target, str):
+            form["target"] = session.target
+        else:                                   # a tool offset: its fields from the session
+            form["target"] = TOOL_TARGET
+            form.update({f"tool_target.{k}": str(v) for k, v in session.target.items()})
+            for key, value in (session.params.get("tolerance") or {}).items():
+                form[f"tolerance.{key}"] = _tolerance_text(fields, key, value, env.gud)
+    typed = {**(form or {}), **_locked_values(fields, session, env.gud)}
+    known = known_values(fields, session.params) if session is not None else None
+    return fields, session, form_data(spec, fields, typed, env.gud, known)
+
+
+def _tolerance_text(fields: list[FieldSpec], key: str, value, gud) -> str:
+    """A session's tolerance value as its field shows it (a length in the screen's unit)."""
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    spec = next((f for f in fields if f.name == f"tolerance.{key}"), None)
+    if spec is not None and spec.unit == "mm" and isinstance(value, int | float):
+        return units.field_text(float(value), gud)
+    return str(value)
 
 
 def _visible_answer(session):
@@ -122,77 +173,120 @@ def _visible_answer(session):
 
 # --- rendering -----------------------------------------------------------------------------
 
+DECISIONS = {   # the strategy's decision (measuring-math §3.5) in the operator's words
+    "none": N_("Within the zero offset range: no correction, the mean value is kept"),
+    "mean": N_("Corrected by the mean value"), "full": N_("Corrected by 100 % of the deviation"),
+    "oversize": N_("Oversize: corrected by 100 %, check the part"), "undersize": N_("Undersize: corrected by 100 %, check the part"),
+    "dimension_difference": N_("Dimension difference exceeded: no correction, check the tool"),
+    "safe_area": N_("Safe area exceeded: no correction"),
+}
+
 RESULT_LABELS = [
-    ("position", "Edge position"), ("corner", "Corner P0"), ("center", "Centre P0"), ("p1", "P1"),
-    ("p2", "P2"), ("distance", "Distance L"), ("diameter", "Diameter"), ("pitch_diameter", "Pitch diameter"),
-    ("length", "Length L"), ("width", "Width W"), ("radius", "Radius R"), ("angle", "Angle α"),
-    ("angle_2", "Angle of 2nd edge"), ("corner_angle", "Corner angle"), ("alpha", "Alpha α"), ("beta", "Beta β"),
+    ("actual", N_("Actual value")), ("deviation", N_("Deviation D")), ("mean_value", N_("Mean value Mv")),
+    ("compensation", N_("Compensation")),
+    ("position", N_("Edge position")), ("corner", N_("Corner P0")), ("center", N_("Centre P0")), ("p1", N_("P1")),
+    ("p2", N_("P2")), ("distance", N_("Distance L")), ("diameter", N_("Diameter")), ("pitch_diameter", N_("Pitch diameter")),
+    ("length", N_("Length L")), ("width", N_("Width W")), ("radius", N_("Radius R")), ("angle", N_("Angle α")),
+    ("angle_2", N_("Angle of 2nd edge")), ("corner_angle", N_("Corner angle")), ("alpha", N_("Alpha α")), ("beta", N_("Beta β")),
 ]
-TOOL_LABELS = {"length": "Length L1", "radius": "Radius R"}
+TOOL_LABELS = {"length": N_("Length L1"), "radius": N_("Radius R")}
 
 
-def result_rows(task: str, result: dict | None) -> list[tuple[str, str, str]]:
-    """(label, value text, unit) of the task's result keys (design.md §4)."""
+def result_rows(task: str, result: dict | None, gud=None) -> list[tuple[str, str, str]]:
+    """(label, value text, unit) of the task's result keys (design.md §4), in the screen's language
+    and unit."""
     if not result:
         return []
     rows = []
-    tool_task = task.startswith("tool.")
+    spec = task_spec(task)
+    if spec.lathe:
+        return lathe_result_rows(result)
+    tool_task = spec.category == Category.TOOL_MEASURING
     for key, label in RESULT_LABELS:
         if key not in result:
             continue
         value = result[key]
         label = TOOL_LABELS.get(key, label) if tool_task else label
-        unit = "°" if key in ANGLE_KEYS else "mm"
-        if key == "center" and task.startswith(("hole.3", "hole.4", "spigot.3", "spigot.4")):
-            label = "P0 (circle centre)" if task.endswith("3") else "P0 (diagonals)"
+        unit = "°" if key in ANGLE_KEYS else units.unit(gud)
+        if key == "center" and spec.points >= 3 and spec.family in (Family.HOLE, Family.SPIGOT):
+            label = N_("P0 (circle centre)") if spec.points == 3 else N_("P0 (diagonals)")
         if isinstance(value, dict):
-            rows += [(f"{label} {axis}", fmt_result(key, v), unit) for axis, v in value.items()]
+            rows += [(f"{_(label)} {axis}", fmt_result(key, v, gud), unit) for axis, v in value.items()]
         elif isinstance(value, int | float):
-            rows.append((label, fmt_result(key, value), unit))
+            rows.append((_(label), fmt_result(key, value, gud), unit))
     for key in ("probe", "tool_probe", "tool"):
         data = result.get(key)
         if isinstance(data, dict):
-            rows += _flat(key.replace("_", " ").capitalize(), data)
+            rows += _flat(_(RECORD_LABELS[key]), data, gud)
     return rows
 
 
-def _flat(prefix: str, data: dict) -> list[tuple[str, str, str]]:
+RECORD_LABELS = {"probe": N_("Probe"), "tool_probe": N_("Tool probe"), "tool": N_("Tool")}
+NOT_LENGTHS = frozenset({"number", "tool", "t", "type", "axes", "points"})
+
+
+def _flat(prefix: str, data: dict, gud=None) -> list[tuple[str, str, str]]:
+    """A record of the result (probe, tool probe, tool) as rows named in the operator's words."""
     rows = []
     for key, value in data.items():
+        name = f"{prefix} {field_name(key)}"
         if isinstance(value, dict):
-            rows += _flat(f"{prefix} {key}", value)
+            rows += _flat(name, value, gud)
         elif isinstance(value, list | tuple) and all(isinstance(v, int | float) for v in value):
-            rows.append((f"{prefix} {key}", " / ".join(fmt_result(key, v) for v in value), ""))
+            rows.append((name, " / ".join(_record_value(key, v, gud) for v in value), ""))
         elif isinstance(value, int | float | bool):
-            rows.append((f"{prefix} {key}", fmt_result(key, value), ""))
+            rows.append((name, _record_value(key, value, gud), ""))
     return rows
 
 
-def correction_rows(correction: dict | None) -> list[dict]:
-    """Before/after of each frame component of the target WO (translation mm, rotation °)."""
+def _record_value(key: str, value, gud) -> str:
+    if isinstance(value, bool) or key in NOT_LENGTHS:
+        return fmt_result(key, value)
+    return fmt_result(key, value, gud)
+
+
+def correction_rows(correction: dict | None, gud=None) -> list[dict]:
+    """Before/after of each frame component of the target WO (translation mm, rotation °), or of
+    the tool data of a tool offset (length, radius and their wear, mm)."""
     if not correction or not correction.get("after"):
         return []
     before, after = correction.get("before") or {}, correction["after"]
     rows = []
-    for part, label in (("trans", "Offset"), ("fine", "Fine"), ("rot", "Rotation")):
+    if correction.get("lathe"):
+        return lathe_correction_rows(correction)
+    if "tool" in correction:
+        for part in (None, "wear"):
+            new_part = after.get(part) if part else after
+            old_part = (before.get(part) if part else before) or {}
+            for key in ("length", "radius"):
+                if key not in (new_part or {}):
+                    continue
+                old, new = float(old_part.get(key, 0.0)), float(new_part[key])
+                rows.append({"label": field_name(f"{part}.{key}" if part else key).capitalize(),
+                             "field": f"{part}.{key}" if part else key, "before": fmt_result("length", old, gud),
+                             "after": fmt_result("length", new, gud), "changed": abs(new - old) > 1e-9})
+        return rows
+    for part, label in (("trans", N_("Offset")), ("fine", N_("Fine")), ("rot", N_("Rotation"))):
         for axis, new in (after.get(part) or {}).items():
             old = (before.get(part) or {}).get(axis, 0.0)
             if part == "fine" and not old and not new:
                 continue
             key = "angle" if part == "rot" else "trans"
-            rows.append({"label": f"{label} {axis}", "field": f"{part}.{axis}",
-                         "before": fmt_result(key, old), "after": fmt_result(key, new),
+            rows.append({"label": f"{_(label)} {axis}", "field": f"{part}.{axis}",
+                         "before": fmt_result(key, old, gud), "after": fmt_result(key, new, gud),
                          "changed": abs(float(new) - float(old)) > 1e-9})
     return rows
 
 
 def _svgs(env: _Env, task: str, params: dict | None, session, answer: dict | None) -> list:
     """Top (and side) view: planned path of the next point from the current ball centre."""
+    spec = task_spec(task)
+    if spec.lathe:
+        return lathe_svgs(env, spec, params, answer)
     try:
         ctx = env.measuring_context()
-        coords = "WCS" if is_workpiece(task) or task.startswith("probe.") else "MCS"
         start = StepExecutor(env.machine.machine, ctx.chain().wcs2bcs, ctx.tool_length,
-                             ctx.plane.infeed_unit).current(coords)
+                             ctx.plane.infeed_unit).current(spec.coords)
     except Exception:       # the preview must never break the screen
         return []
     steps = []
@@ -200,8 +294,8 @@ def _svgs(env: _Env, task: str, params: dict | None, session, answer: dict | Non
     if params is not None and not result:
         n = (session.next_point() if session is not None else None) or 1
         try:
-            normalised = planning.validate_params(task, params, ctx.plane)
-            steps = planning.planned_path(task, normalised, n, np.asarray(start), planning.context_from(ctx))
+            normalised = spec.validate(params, ctx.plane)
+            steps = ideal_path(spec.program(normalised, n, np.asarray(start), planning.context_from(ctx)), start)
         except Exception:
             steps = []
     points = session.to_api()["points"] if session is not None else []
@@ -215,17 +309,20 @@ def _screen_context(env: _Env, page: TaskPage, form: dict | None, *, answer=None
     task = page.task
     fields, session, data = _typed(env, task, form)
     stored_any = _stored_any(session)
-    n_points = planning.TASK_POINTS[task]
+    spec = task_spec(task)
+    n_points = spec.points
     if answer is None:
         answer = _visible_answer(session)
     if answer is not None and "result" not in answer:
         answer = None
     setup = (answer or {}).get("setup_support")
+    if setup and setup.get("done"):         # carried out or left: the result stays, the hand-over goes
+        setup = None
     points = session.to_api()["points"] if session is not None else \
         [{"n": n, "stored": False} for n in range(1, n_points + 1)]
     errors = errors or {}
     tool = None
-    if task.startswith(("tool.", "toolprobe.")):
+    if spec.family.tool_measuring:
         st = env.machine.status()
         tool = {"t": st["tool"], "length": st["tool_length"], "mode": env.gud.tool_offset_mode,
                 "probe_number": env.gud.tool_probe_number}
@@ -236,8 +333,12 @@ def _screen_context(env: _Env, page: TaskPage, form: dict | None, *, answer=None
             except Exception:
                 tool["radius"] = None
     warnings = list((answer or {}).get("warnings") or (session.warnings if session is not None else []))
+    if spec.lathe:
+        tool = lathe_tool_info(env)
     return {
-        "screen": "measure_tool" if task.startswith(("tool.", "toolprobe.")) else "measure_workpiece",
+        "screen": "measure_lathe" if spec.lathe else ("measure_tool" if spec.family.tool_measuring
+                                                      else "measure_workpiece"),
+        "lathe": spec.lathe, "diamon": env.machine.diameter_programming,
         "page": page, "task": task,
         "fields": [{"spec": f, "value": data.values.get(f.name, ""), "error": errors.get(f.name),
                     "locked": f.locks and stored_any, "id": f.name.replace(".", "-")} for f in fields],
@@ -246,13 +347,26 @@ def _screen_context(env: _Env, page: TaskPage, form: dict | None, *, answer=None
         "can_calculate": session is not None and session.can_calculate,
         "next_point": (session.next_point() if session is not None else 1) or None,
         "answer": answer, "setup": setup, "session_id": session.id if session is not None else None,
-        "result_rows": result_rows(task, (answer or {}).get("result")),
+        "result_rows": result_rows(task, (answer or {}).get("result"), env.gud),
         "correction": (answer or {}).get("correction"),
-        "correction_rows": correction_rows((answer or {}).get("correction")),
-        "warnings": warnings, "alarm": alarm, "notice": notice, "tool": tool,
+        "correction_rows": correction_rows((answer or {}).get("correction"), env.gud),
+        "warnings": warnings, "alarm": alarm, "tool": tool,
+        "alarm_remedy": ((session.last_alarm or {}).get("remedy") if alarm and session is not None else "") or "",
+        "notice": notice or (session.notice if session is not None else "") or "",
         "svgs": _svgs(env, task, data.params, session, answer),
         "vkeys_task": True,
+        "tool_mode": data.values.get("target") == TOOL_TARGET,
+        "decision": _decision(answer),
+        "decision_alarm": ((answer or {}).get("result") or {}).get("alarm"),
+        "running": bool(session is not None and session.running),
+        "progress": (session.progress if session is not None else None) or {},
+        **task_help.context(env.services, task, data.values),      # help picture, equipment (issue 17 item 5)
     }
+
+
+def _decision(answer: dict | None) -> str | None:
+    decision = ((answer or {}).get("result") or {}).get("decision")
+    return _(DECISIONS[decision]) if decision in DECISIONS else None
 
 
 def _render(request: Request, ctx: dict, message: str = "", level: str = "info", status_code: int = 200):
@@ -264,14 +378,12 @@ def _render(request: Request, ctx: dict, message: str = "", level: str = "info",
 
 
 def input_screen(task: str):
-    """The GET handler registered in ``measure.INPUT_SCREENS``: a fresh screen, old points discarded."""
+    """The GET handler registered in ``measure.INPUT_SCREENS``: the task's open session as the
+    server holds it (a refresh or a second tab loses nothing, design.md §9.1), else a fresh
+    screen. Back (leave) discards the points (jog-measuring §3.1)."""
 
     def handler(request: Request):
-        env = _Env(request)
-        session = env.workflow.session
-        if session is not None and not session.running:
-            env.workflow.delete(session.id)       # entering a screen starts a new measurement (spec §3.1)
-        return _render(request, _screen_context(env, _page(task), None))
+        return _render(request, _screen_context(_Env(request), _page(task), None))
 
     return handler
 
@@ -280,10 +392,15 @@ for _task in PAGES:
     measure.INPUT_SCREENS[_task] = input_screen(_task)
 
 
+def input_screen_with(request: Request, task: str, message: str = "", notice: str = ""):
+    """The input screen of ``task`` with a message and a notice (what the set-up support did)."""
+    return _render(request, _screen_context(_Env(request), _page(task), None, notice=notice), message)
+
+
 # --- actions -------------------------------------------------------------------------------
 
 def _error_view(env: _Env, page: TaskPage, form: dict, exc: WorkflowError):
-    fields = fields_for(page.task, env.form_env)
+    fields = task_spec(page.task).form(env.form_env)
     errors, alarm, notice = {}, None, ""
     if exc.field:
         name = field_of_error(fields, exc.field)
@@ -292,7 +409,8 @@ def _error_view(env: _Env, page: TaskPage, form: dict, exc: WorkflowError):
         alarm = exc.message
     else:
         notice = exc.message
-    return _screen_context(env, page, form, alarm=alarm, errors=errors, notice=notice), exc.message
+    line = next(iter(errors.values())) if errors else exc.message     # the message line names the field too
+    return _screen_context(env, page, form, alarm=alarm, errors=errors, notice=notice), line
 
 
 def _apply_form(env: _Env, page: TaskPage, form: dict):
@@ -303,20 +421,50 @@ def _apply_form(env: _Env, page: TaskPage, form: dict):
     return env.workflow.create(page.task, data.params, data.target)
 
 
+NC_ANSWER_WAIT_S = 0.4      # a short measurement answers at once; a longer one shows its progress
+
+
 def _nc_start(env: _Env, page: TaskPage, form: dict):
+    """NC Start runs on in the background (design.md §9.1): a measurement that ends within
+    NC_ANSWER_WAIT_S answers with its outcome, a longer one with its progress, which the screen
+    fetches again (``progress``) on each session event of the live feed until the outcome."""
     session = _apply_form(env, page, form)
-    answer = env.workflow.start(session.id)
-    n = answer["point"]["n"]
-    if "result" in answer:
-        return {"answer": answer}, "Measurement done" + (": WO activated" if answer.get("activated") else "")
-    return {}, f"P{n} stored" + ("; press Calculate" if session.can_calculate else "")
+    require_measurement(env.request, session.task, session.target)    # 403 shown on the screen
+    env.workflow.start(session.id, wait=False)
+    n = (session.progress or {}).get("point", 1)
+    deadline = time.monotonic() + NC_ANSWER_WAIT_S
+    while session.running and time.monotonic() < deadline:
+        time.sleep(0.005)
+    if session.running:
+        return {}, f"NC Start: measuring P{n}"
+    message, level = _outcome(session, n)
+    if level == "error":
+        raise WorkflowError(409, "alarm", message)
+    return {"answer": _visible_answer(session)}, message
+
+
+def _outcome(session, n: int) -> tuple[str, str]:
+    """The message line once point ``n`` ended: (text, level)."""
+    if session.last_alarm:
+        return f"{session.last_alarm['code']} {session.last_alarm['text']}", "error"
+    answer = _visible_answer(session)
+    if session.single_point and answer and "result" in answer:
+        return "Measurement done" + (": WO activated" if answer.get("activated") else ""), "info"
+    try:
+        stored = session.slot(n).stored
+    except KeyError:
+        stored = False
+    if stored:
+        return f"P{n} stored" + ("; press Calculate" if session.can_calculate else ""), "info"
+    return "", "info"
 
 
 def _calculate(env: _Env, page: TaskPage, form: dict):
     session = env.session_of(page.task)
     if session is None:
         raise WorkflowError(409, "points_missing", "Calculate needs all points stored")
-    _apply_form(env, page, form)
+    session = _apply_form(env, page, form)
+    require_measurement(env.request, session.task, session.target)
     answer = env.workflow.calculate(session.id)
     return {"answer": answer}, "Calculated" + (": WO activated" if answer.get("activated") else "")
 
@@ -347,22 +495,40 @@ async def _act(request: Request, task: str, action):
     return await run_in_threadpool(run)
 
 
-@router.post("/measure/task/{task}/start")
+@router.post("/measure/task/{task}/start", name="measure_task_start", dependencies=[needs("measure")])
 async def nc_start(request: Request, task: str):
     return await _act(request, task, _nc_start)
 
 
-@router.post("/measure/task/{task}/calculate")
+@router.get("/measure/task/{task}/progress", name="measure_task_progress", dependencies=[needs("view")])
+async def progress(request: Request, task: str, n: int | None = None):
+    """Fetched on each session event while NC Start runs (static/live.js): the screen with its
+    progress, then the screen with the outcome."""
+    page = _page(task)
+
+    def run():
+        env = _Env(request)
+        session = env.session_of(task)
+        if session is not None and session.running:
+            return _render(request, _screen_context(env, page, None), "", "info")
+        message, level = _outcome(session, n or 1) if session is not None else ("", "info")
+        alarm = message if level == "error" else None
+        return _render(request, _screen_context(env, page, None, alarm=alarm), message, level)
+
+    return await run_in_threadpool(run)
+
+
+@router.post("/measure/task/{task}/calculate", name="measure_task_calculate", dependencies=[needs("measure")])
 async def calculate(request: Request, task: str):
     return await _act(request, task, _calculate)
 
 
-@router.post("/measure/task/{task}/invalidate/{n}")
+@router.post("/measure/task/{task}/invalidate/{n}", name="measure_task_invalidate", dependencies=[needs("measure")])
 async def invalidate(request: Request, task: str, n: int):
     return await _act(request, task, _invalidate(n))
 
 
-@router.post("/measure/task/{task}/refresh")
+@router.post("/measure/task/{task}/refresh", name="measure_task_refresh", dependencies=[needs("measure")])
 async def refresh(request: Request, task: str):
     """Re-draw from the typed values (after Reset, and the Select softkey of tool-probe calibration)."""
     def action(env, page, form):
@@ -372,7 +538,7 @@ async def refresh(request: Request, task: str):
     return await _act(request, task, action)
 
 
-@router.post("/measure/task/{task}/check/{name}")
+@router.post("/measure/task/{task}/check/{name}", name="measure_task_check", dependencies=[needs("measure")])
 async def check_field(request: Request, task: str, name: str):
     """A field changed: its error next to it, the live SVG redrawn; setpoints go into the session."""
     _page(task)
@@ -383,7 +549,7 @@ async def check_field(request: Request, task: str, name: str):
         fields, session, data = _typed(env, task, form)
         error = None
         try:
-            planning.validate_params(task, data.params, env.form_env.plane)
+            task_spec(task).validate(data.params, env.form_env.plane)
             if _stored_any(session):
                 env.workflow.update_params(session.id, data.params, data.target)
         except (ValueError, WorkflowError) as exc:
@@ -397,7 +563,7 @@ async def check_field(request: Request, task: str, name: str):
     return await run_in_threadpool(run)
 
 
-@router.post("/measure/task/{task}/svg")
+@router.post("/measure/task/{task}/svg", name="measure_task_svg", dependencies=[needs("measure")])
 async def svg(request: Request, task: str):
     """The live SVG, polled while the screen is open (probe position, planned path)."""
     _page(task)
@@ -412,21 +578,12 @@ async def svg(request: Request, task: str):
     return await run_in_threadpool(run)
 
 
-@router.post("/measure/task/{task}/leave")
+@router.post("/measure/task/{task}/leave", name="measure_task_leave", dependencies=[needs("measure")])
 def leave(request: Request, task: str):
-    """Back: leaving the input screen aborts the measurement and discards stored points (spec §3.1)."""
+    """Back: leaving the input screen aborts the measurement and discards stored points (jog-measuring §3.1)."""
     page = _page(task)
     workflow = request.app.state.services.workflow
     session = workflow.session
     if session is not None and session.task == task:
         workflow.delete(session.id)
-    parent = page.back[1]
-    parts = parent.strip("/").split("/")
-    if parts == ["measure", "workpiece"]:
-        response = measure.workpiece_menu(request)
-    elif parts == ["measure", "tool"]:
-        response = measure.tool_menu(request)
-    else:
-        response = measure.workpiece_group(request, parts[-1])
-    response.headers["HX-Push-Url"] = parent
-    return response
+    return measure.menu_screen(request, page.back[1])

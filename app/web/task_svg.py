@@ -13,7 +13,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from markupsafe import Markup, escape
 
+from app.i18n import _
+from app.workflow.tasks import task_spec
 from engine.planes import Plane
+from engine.tasks import Family
 from engine.types import MoveStep, ProbeStep
 
 from .templating import fixed
@@ -96,10 +99,10 @@ class View:
 
 
 def needs_side_view(task: str, params: dict | None) -> bool:
-    family = task.split(".")[0]
-    if task in ("plane.align", "probe.length") or family == "spigot":
+    family = task_spec(task).family
+    if task in ("plane.align", "probe.length") or family == Family.SPIGOT:
         return True
-    return family == "edge" and (params or {}).get("axis") == "Z"
+    return family == Family.EDGE and (params or {}).get("axis") == "Z"
 
 
 def draw(task: str, plane: Plane, *, params: dict | None = None, start=None, steps=(), points=(),
@@ -118,7 +121,8 @@ def draw(task: str, plane: Plane, *, params: dict | None = None, start=None, ste
         _stored(view, points)
         if start is not None:
             view.circle(view.uv(start), ball_radius, "ball")
-    titles = {"top": f"Top view ({plane.first}/{plane.second})", "side": f"Side view ({plane.first}/{plane.infeed})"}
+    titles = {"top": _("Top view (%(a)s/%(b)s)", a=plane.first, b=plane.second),
+              "side": _("Side view (%(a)s/%(b)s)", a=plane.first, b=plane.infeed)}
     return [v.svg(titles[v.name]) for v in views]
 
 

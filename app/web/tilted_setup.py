@@ -1,4 +1,4 @@
-"""Guided "tilted workpiece set-up" (spec/jog-measuring.md §6.1 chain measuring, §6.2, §6.3).
+"""Guided "tilted workpiece set-up" (spec/jog-measuring.md §6.1 chain measuring, jog-measuring §6.2, jog-measuring §6.3).
 
 A step list that walks the operator through the chain that ends in a full 6-DOF zero offset:
 
@@ -11,7 +11,7 @@ A step list that walks the operator through the chain that ends in a full 6-DOF 
 Each step opens the existing input screen; from step 2 on, the WO the previous step produced is
 the proposal ``_JM_I[6]`` (db state ``jm_i6``, written by the set-up support) and is activated
 before the input screen opens, so that its "Zero offset" field is preset to it. Step 1 has no
-predecessor: it activates G500 (the measuring WO of spec §6.2 example 2) and the operator selects
+predecessor: it activates G500 (the measuring WO of jog-measuring §6.2 example 2) and the operator selects
 the target WO in the orient-plane screen (the input screens take no preset from a URL).
 
 Which steps are done comes from the measurement log (entries after the guided set-up was
@@ -23,14 +23,17 @@ from __future__ import annotations
 from fastapi import APIRouter, Form, Request
 from fastapi.responses import RedirectResponse
 
+from app.access.deps import needs
 from app.workflow import setup_support as support
 from engine.frames import Frame
 
-from .templating import render_screen, vkeys
+from .task_screens import PAGES
+from .templating import render_screen, softkey, url_path, vkeys
 
 router = APIRouter()
-URL = "/measure/workpiece/tilted-setup"
 G500 = "G500"
+# the input screens the steps open: step n -> task (5: Align edge in place of step 3's corner)
+STEP_TASKS = {1: "plane.align", 3: "corner.right", 4: "edge.set", 5: "edge.align"}
 
 
 def _log_since(log, since: int) -> list[dict]:
@@ -43,7 +46,7 @@ def _measuring_wo(entry: dict) -> str | None:
 
 
 def steps_model(services) -> dict:
-    """The step list with done flags, the open URLs and the resulting WO."""
+    """The step list with done flags and the resulting WO."""
     state = support.guided_state(services.db)
     target = state.get("target")
     machine = services.machine
@@ -85,7 +88,6 @@ def steps_model(services) -> dict:
     for step, is_done in zip(steps, done, strict=True):
         step["done"] = is_done
         step["current"] = step["n"] == current
-        step["open"] = f"{URL}/open/{step['n']}"
     offset = services.offsets.list().get(target) if target else None
     return {"target": target, "steps": steps, "complete": all(done) and target is not None,
             "current": current, "chain_wo": chain_wo, "active": machine.active_offset,
@@ -99,7 +101,7 @@ def _render(request: Request, notice: str = ""):
     model = steps_model(services)
     return render_screen(request, "tilted_setup.html", {
         "screen": "measure_workpiece", "m": model, "notice": notice,
-        "vkeys": vkeys([], {"label": "Back", "href": "/measure/workpiece"}),
+        "vkeys": vkeys([], softkey(request, "Back", "measure_workpiece_menu")),
         "message": notice or _dialog(model)})
 
 
@@ -111,22 +113,22 @@ def _dialog(model: dict) -> str:
     return f"Next: step {model['current']}"
 
 
-@router.get(URL)
+@router.get("/measure/workpiece/tilted-setup", name="tilted_setup_screen")
 def screen(request: Request):
     return _render(request)
 
 
-@router.post(URL + "/start")
+@router.post("/measure/workpiece/tilted-setup/start", name="tilted_setup_start", dependencies=[needs("measure")])
 def start(request: Request, target: str = Form("G54")):
     """Start (or restart) the guided set-up for ``target``; the chain proposal ``_JM_I[6]`` is reset."""
     services = request.app.state.services
     if target not in services.offsets.names() or not target.startswith("G5"):
         return _render(request, notice=f"{target!r} is not a settable zero offset")
     support.start_guided(services.db, target)
-    return RedirectResponse(URL, status_code=303)
+    return RedirectResponse(url_path(request, "tilted_setup_screen"), status_code=303)
 
 
-@router.post(URL + "/open/{n}")
+@router.post("/measure/workpiece/tilted-setup/open/{n}", name="tilted_setup_open", dependencies=[needs("measure")])
 def open_step(request: Request, n: int):
     """Open the input screen of step ``n`` with its measuring WO active (preset of the target)."""
     services = request.app.state.services
@@ -136,19 +138,18 @@ def open_step(request: Request, n: int):
     machine = services.machine
     if n == 1:
         machine.activate(G500)
-        return RedirectResponse("/measure/workpiece/plane", status_code=303)
+        return RedirectResponse(PAGES[STEP_TASKS[1]].href(request), status_code=303)
     if n == 2:
         session = services.workflow.session
         last = (session.last or {}) if session is not None else {}
         if session is None or session.task != "plane.align" or not last.get("setup_support"):
             return _render(request, notice="Measure step 1 (Orient plane) first: its set-up support "
                                            "screen activates the WO")
-        return RedirectResponse(f"/measure/setup-support/{session.id}", status_code=303)
+        href = url_path(request, "setup_support_screen", session_id=session.id)
+        return RedirectResponse(href, status_code=303)
     if n in (3, 4, 5):
         proposal = model["chain_wo"] or model["target"]
         if machine.active_offset != proposal:
             machine.activate(proposal)
-        href = {3: "/measure/workpiece/corner/right", 4: "/measure/workpiece/edge/set",
-                5: "/measure/workpiece/edge/align"}[n]
-        return RedirectResponse(href, status_code=303)
+        return RedirectResponse(PAGES[STEP_TASKS[n]].href(request), status_code=303)
     return _render(request, notice=f"no step {n}")

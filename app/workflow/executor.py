@@ -1,8 +1,9 @@
 """Executes the engine's planned steps on the machine (data flow of design.md §2).
 
 The plan speaks the measuring WCS (or MCS for tool tasks) and the NC's reference point (ball
-centre / tool tip); the machine speaks MCS axis positions of the tool reference point. This
-module is the only place where the two meet.
+centre / tool tip); the machine speaks MCS axis positions of the tool reference point; the
+conversion between the two is ``engine.coords.ToolTip``, on a lathe ``engine.coords.LatheToolTip``
+(``P = F − (L1·x̂ + L2·ẑ)``, handed in as ``tip``).
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from app.machine.protocol import Alarm, Machine, MachineAlarm
+from engine.coords import GEOMETRY_AXES, LatheToolTip, ToolTip, length_axis
 from engine.frames import Frame
 from engine.types import Latch, MoveStep, ProbeStep, SpindleStep, Step
 
@@ -20,52 +22,32 @@ class MotionAborted(Exception):
     """The motion was stopped without an alarm (Reset)."""
 
 
-def length_axis(status, infeed_unit) -> np.ndarray:
-    """Direction of the tool length L in MCS: the plane's infeed unit while the tool axis is +Z
-    (3-axis convention, any plane); TRAORI-like, a swivelled head's actual tool axis (status)."""
-    axis = getattr(status, "tool_axis", None)
-    if axis is not None:
-        axis = np.asarray(axis, dtype=float)
-        if axis.shape == (3,) and float(np.linalg.norm(axis - np.array([0.0, 0.0, 1.0]))) >= 1e-12:
-            return axis
-    return np.asarray(infeed_unit, dtype=float)
-
-
 @dataclass
 class StepExecutor:
     machine: Machine
     wcs2bcs: Frame              # measuring chain, BCS = MCS (no kinematic transformation)
     tool_length: float          # the NC's offset length L1 of the active tool
-    tool_axis_mcs: np.ndarray   # unit vector from tool tip to spindle (G17: +Z)
+    infeed_unit: np.ndarray     # the plane's infeed axis (G17: +Z): where L acts on a 3-axis machine
+    tip: ToolTip | LatheToolTip | None = None    # None: the milling convention from the above
 
     def __post_init__(self) -> None:
-        self.tool_axis_mcs = length_axis(self.machine.status(), self.tool_axis_mcs)
+        if self.tip is None:
+            axis = length_axis(getattr(self.machine.status(), "tool_axis", None), self.infeed_unit)
+            self.tip = ToolTip(self.wcs2bcs, float(self.tool_length), axis)
 
-    # --- conversions (names carry the direction) ----------------------------------------
+    @property
+    def tip_conversion(self) -> ToolTip | LatheToolTip:
+        """``tip`` as set up: never None once ``__post_init__`` has run."""
+        assert self.tip is not None, "StepExecutor.__post_init__ sets tip"
+        return self.tip
+
     def axes_mcs(self) -> np.ndarray:
         mcs = self.machine.status().mcs
-        return np.array([mcs["X"], mcs["Y"], mcs["Z"]])
-
-    def tip_in_mcs(self, axes_mcs) -> np.ndarray:
-        return np.asarray(axes_mcs, dtype=float) - self.tool_length * self.tool_axis_mcs
-
-    def axes_for_tip_mcs(self, tip_mcs) -> np.ndarray:
-        return np.asarray(tip_mcs, dtype=float) + self.tool_length * self.tool_axis_mcs
-
-    def tip_in_wcs(self, axes_mcs) -> np.ndarray:
-        return self.wcs2bcs.parent2child(self.tip_in_mcs(axes_mcs))
+        return np.array([mcs[a] for a in GEOMETRY_AXES])
 
     def current(self, coords: str) -> np.ndarray:
-        axes = self.axes_mcs()
-        return self.tip_in_wcs(axes) if coords == "WCS" else self.tip_in_mcs(axes)
-
-    def axes_for_tip(self, target, coords: str) -> np.ndarray:
-        tip_mcs = self.wcs2bcs.child2parent(target) if coords == "WCS" else np.asarray(target, float)
-        return self.axes_for_tip_mcs(tip_mcs)
-
-    def _dir_mcs(self, direction, coords: str) -> np.ndarray:
-        d = np.asarray(direction, dtype=float)
-        return self.wcs2bcs.dir_child2parent(d) if coords == "WCS" else d
+        """Where the NC's tool reference is now, in ``coords``."""
+        return self.tip_conversion.tip_in(self.axes_mcs(), coords)
 
     # --- execution ----------------------------------------------------------------------
     def _raise_for(self, alarm: Alarm | None) -> None:
@@ -75,21 +57,23 @@ class StepExecutor:
 
     def run(self, step: Step) -> Latch | None:
         if isinstance(step, MoveStep):
-            axes = self.axes_for_tip(step.target, step.coords)
+            axes = self.tip_conversion.axes_for_tip(step.target, step.coords)
             result = self.machine.goto({"X": axes[0], "Y": axes[1], "Z": axes[2]}, step.feed)
             if not result.completed:
                 self._raise_for(result.alarm)
             return None
         if isinstance(step, ProbeStep):
             alarms_before = len(self.machine.status().alarms)
-            result = self.machine.probe(self._dir_mcs(step.direction, step.coords), step.distance, step.feed)
+            probed = self.machine.probe(self.tip_conversion.direction_in_mcs(step.direction, step.coords),
+                                        step.distance, step.feed)
             new_alarms = self.machine.status().alarms[alarms_before:]
             if new_alarms:  # broken probe, limit: the point ends, nothing is stored
                 raise MachineAlarm(new_alarms[-1])
-            if not result.triggered:
+            if not probed.triggered:
                 return Latch(triggered=False)
-            latched = np.array([result.latched_mcs[a] for a in ("X", "Y", "Z")])
-            rec = self.tip_in_wcs(latched) if step.coords == "WCS" else self.tip_in_mcs(latched)
+            assert probed.latched_mcs is not None, "every machine latches the axes on a trip"
+            latched = np.array([probed.latched_mcs[a] for a in GEOMETRY_AXES])
+            rec = self.tip_conversion.tip_in(latched, step.coords)
             return Latch(triggered=True, rec=rec, latched_mcs=latched)
         if isinstance(step, SpindleStep):
             if step.angle is not None:

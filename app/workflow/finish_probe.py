@@ -1,10 +1,10 @@
 """Finishers of the workpiece probe calibration: ``probe.length`` and ``probe.radius``.
 
-Spec: spec/jog-measuring.md §5.2/§5.3, measuring-math §7.2/§7.3/§7.5; math in engine.calibration.
-The finisher writes the probe record ``_WP[k]`` (``app.services.probes.ProbeData``) and, for
+Spec: spec/jog-measuring.md §5.2/jog-measuring §5.3, measuring-math §7.2/measuring-math §7.3/measuring-math §7.5; math in engine.calibration.
+The finisher writes the probe record ``_WP[k]`` (``app.records.ProbeData``) and, for
 length calibration, the probe's tool length L1 (the machine gets it via refresh_tool_offset).
 Every record remembers how it was calibrated: measuring feed and feed override (the measuring
-tasks warn when the override differs, spec §5.1), time, gauge (ring diameter or surface
+tasks warn when the override differs, jog-measuring §5.1), time, gauge (ring diameter or surface
 height and the WO it refers to), plane, and the tool number of the probe it belongs to (the
 active record follows the tool in the spindle, app.services.measuring).
 """
@@ -13,16 +13,17 @@ from __future__ import annotations
 
 from datetime import UTC, datetime
 
-from app.workflow.service import MeasureSession, MeasuringContext
+from app.records import ProbeData
+from app.workflow.context import MeasuringContext
+from app.workflow.session import MeasureSession
+from engine import alarms
 from engine.calibration import evaluate_probe_task
 from engine.types import MeasuringError, ProbeRecord
-
-NO_PROBE_ALARM = 61309      # "Check probe type" (spec §10): no type-710 probe in the spindle
 
 
 def _probe_of(ctx: MeasuringContext) -> ProbeRecord:
     if ctx.probe is None or ctx.tool is None:
-        raise MeasuringError(NO_PROBE_ALARM, "No workpiece probe (type 710) in the spindle: load the probe")
+        raise MeasuringError(alarms.PROBE_TYPE, "No workpiece probe (type 710) in the spindle: load the probe")
     return ctx.probe
 
 
@@ -41,14 +42,12 @@ def _record(ctx: MeasuringContext, probe: ProbeRecord, extra: dict) -> tuple[int
         "calibrated_radius": bool(probe.calibrated_radius),
         "calibrated_length": bool(probe.calibrated_length),
         "calibrated_plane": ctx.plane.name,
-        "calibration_feed": float(ctx.settings.get("measuring_feed", 300.0)),
+        "calibration_feed": float(ctx.settings.measuring_feed),
         "calibration_override": float(ctx.feed_override),
         "calibrated_at": datetime.now(UTC).isoformat(timespec="seconds"),
         "tool": int(ctx.tool["t"]) if ctx.tool else stored.get("tool"),
         **extra,
     }
-    from app.services.probes import ProbeData  # lazy: app.services imports the workflow
-
     return n, ProbeData.model_validate(record).model_dump(mode="json")
 
 
@@ -58,30 +57,44 @@ def surface_height(params: dict, infeed: str) -> float:
     return float(value.get(infeed, 0.0) if isinstance(value, dict) else value)
 
 
-def finish_probe_radius(session: MeasureSession, ctx: MeasuringContext) -> tuple[dict, dict]:
+def _first_harmonic(point) -> str:
+    """Off-centre chords observe the pre-travel's first harmonic apart from the eccentricity."""
+    chords = any("/" in str(key) for ring_pass in point.passes for key in ring_pass.rec)
+    return "estimate" if chords else "convention"
+
+
+def finish_probe_radius(session: MeasureSession, ctx: MeasuringContext, points: list) -> tuple[dict, dict]:
     probe = _probe_of(ctx)
-    point = session.slots[0].point
+    point = points[0]
     try:
+        # least squares from every touch of both spindle passes (measuring-math §7.3, engine.calibration)
         new, values = evaluate_probe_task("probe.radius", session.params, point, probe, ctx.plane,
-                                          wcs2bcs=ctx.chain().wcs2bcs)
+                                          wcs2bcs=ctx.chain().wcs2bcs, pretravel_frame=ctx.settings.pretravel_frame,
+                                          first_harmonic=_first_harmonic(point))
     except ValueError as exc:
-        raise MeasuringError(61301, str(exc)) from exc
+        raise MeasuringError(alarms.PROBE_NOT_SWITCHED, str(exc)) from exc
+    planes = sorted({*(ctx.probe_data or {}).get("calibrated_planes", []), ctx.plane.name})
+    # more than 4 directions: the direction-dependent map is stored and used for every touch
+    # (engine.lobing); 4 directions replace an older map by the 4 trigger values
+    lobing = values.get("lobing") if int(session.params.get("directions", 4) or 4) > 4 else None
     n, record = _record(ctx, new, {"cal_ring_diameter": float(session.params["diameter"]),
-                                   "cal_wo": ctx.active_offset})
+                                   "cal_wo": ctx.active_offset, "calibrated_planes": planes,
+                                   "calibrated_spindle_angle": 0.0,      # the ring program ends at SPOS 0
+                                   "lobing": lobing})
     values["probe"] = {**values["probe"], **_calibration_view(record)}
     answer = {"result": values, "correction": None, "activated": False, "setup_support": None}
     return answer, {"offset": None, "probe_update": (n, record)}
 
 
-def finish_probe_length(session: MeasureSession, ctx: MeasuringContext) -> tuple[dict, dict]:
+def finish_probe_length(session: MeasureSession, ctx: MeasuringContext, points: list) -> tuple[dict, dict]:
     probe = _probe_of(ctx)
-    point = session.slots[0].point
+    point = points[0]
     height = surface_height(session.params, ctx.plane.infeed)
     try:
         new, values = evaluate_probe_task("probe.length", {**session.params, "setpoint": height}, point,
                                           probe, ctx.plane, length_old=float(ctx.tool_length))
     except ValueError as exc:
-        raise MeasuringError(61301, str(exc)) from exc
+        raise MeasuringError(alarms.PROBE_NOT_SWITCHED, str(exc)) from exc
     # the NC measured with L1 + wear; the difference goes into the geometry L1 (DP3)
     tool = dict(ctx.tool or {})
     t = int(tool["t"])
@@ -89,7 +102,7 @@ def finish_probe_length(session: MeasureSession, ctx: MeasuringContext) -> tuple
               "wear": {"length": float((tool.get("wear") or {}).get("length", 0.0))}}
     length_new = before["length"] + values["difference"]
     if length_new <= 0.0:
-        raise MeasuringError(61301, f"calibrated length L1 = {length_new:.4f} is not positive: "
+        raise MeasuringError(alarms.PROBE_NOT_SWITCHED, f"calibrated length L1 = {length_new:.4f} is not positive: "
                                     "check the surface height")
     values["length"] = length_new
     n, record = _record(ctx, new, {"cal_height": height,
@@ -108,6 +121,3 @@ def _calibration_view(record: dict) -> dict:
     keys = ("number", "tool", "calibrated_plane", "calibration_feed", "calibration_override",
             "calibrated_at", "cal_ring_diameter", "cal_height", "cal_wo")
     return {k: record.get(k) for k in keys}
-
-
-FINISHERS = {"probe.length": finish_probe_length, "probe.radius": finish_probe_radius}

@@ -1,12 +1,12 @@
 """Finishers of tool measuring in JOG: ``toolprobe.calibrate``, ``tool.length``, ``tool.diameter``.
 
-Spec: spec/jog-measuring.md §7.2/§7.3 (+ §8.3 E_MESS_MT_*), measuring-math §14; the math is
+Spec: spec/jog-measuring.md §7.2/jog-measuring §7.3 (+ jog-measuring §8.3 E_MESS_MT_*), measuring-math §14; the math is
 engine.toolmeasure. The points come from engine.plan_tool (tool tip in MCS at the latch).
 
-- Calibration writes the tool-probe record ``_TP[n]`` (``app.services.probes.ToolProbeData``):
+- Calibration writes the tool-probe record ``_TP[n]`` (``app.records.ToolProbeData``):
   trigger values per travel direction (tool edge at switching, MCS), how it was calibrated
   (tool, feed, override, time) and the E_MESS_MT_* data it was calibrated with.
-- Length / diameter write the active tool's offset (spec §7.3, _JM_B[0]): ``geometry`` ->
+- Length / diameter write the active tool's offset (jog-measuring §7.3, _JM_B[0]): ``geometry`` ->
   geometry := measured, the wear of that component := 0; ``wear`` -> wear := measured − geometry.
   The API parameter ``compensation`` overrides the setting ``tool_offset_mode`` (_JM_B[0]).
 
@@ -19,8 +19,13 @@ from __future__ import annotations
 
 from datetime import UTC, datetime
 
+from pydantic import ValidationError
+
+from app.records import ToolData, ToolProbeData
+from app.workflow.context import MeasuringContext
 from app.workflow.planning import active_tool, tool_probe_widths
-from app.workflow.service import MeasureSession, MeasuringContext
+from app.workflow.session import MeasureSession
+from engine import alarms
 from engine.plan_base import ToolPoint, ToolProbePoint
 from engine.toolmeasure import (
     calibrate_tool_probe_point,
@@ -37,42 +42,37 @@ def _now() -> str:
     return datetime.now(UTC).isoformat(timespec="seconds")
 
 
-def _point(session: MeasureSession, kind: type):
-    point = session.slots[0].point
+def _point(session: MeasureSession, points: list, kind: type):
+    point = points[0] if points else None
     if not isinstance(point, kind):
-        raise MeasuringError(61301, f"{session.task}: no measured point stored")
+        raise MeasuringError(alarms.PROBE_NOT_SWITCHED, f"{session.task}: no measured point stored")
     return point
 
 
 def _tool_probe_number(ctx: MeasuringContext) -> int:
-    return int(ctx.extra.get("tool_probe_number") or ctx.settings.get("tool_probe_number", 1))
+    return int(ctx.extra.get("tool_probe_number") or ctx.settings.tool_probe_number)
 
 
 def _validated_tool_probe(record: dict) -> dict:
-    from app.services.probes import ToolProbeData  # lazy: app.services imports the workflow
-
     return ToolProbeData.model_validate(record).model_dump(mode="json")
 
 
 def _validated_tool(row: dict) -> dict:
-    from pydantic import ValidationError
-
-    from app.services.tools import ToolData
-
     try:
         return ToolData.model_validate(row).model_dump()
     except ValidationError as exc:
         first = exc.errors()[0]
         where = ".".join(str(p) for p in first["loc"])
-        raise MeasuringError(61303, f"Measured tool data out of range ({where}: {first['msg']}): "
+        raise MeasuringError(alarms.SAFE_AREA, f"Measured tool data out of range ({where}: {first['msg']}): "
                                     "check the tool probe calibration and the tool") from None
 
 
-# --- tool probe calibration (spec §7.2, math §14.5) --------------------------------------------
+# --- tool probe calibration (jog-measuring §7.2, measuring-math §14.5) --------------------------------------------
 
-def finish_toolprobe_calibrate(session: MeasureSession, ctx: MeasuringContext) -> tuple[dict, dict]:
+def finish_toolprobe_calibrate(session: MeasureSession, ctx: MeasuringContext, points: list
+                               ) -> tuple[dict, dict]:
     tool = active_tool(ctx)
-    point = _point(session, ToolProbePoint)
+    point = _point(session, points, ToolProbePoint)
     n = _tool_probe_number(ctx)
     stored = dict(ctx.extra.get("tool_probe") or {})
     old_trigger = {k: float(v) for k, v in (stored.get("trigger") or {}).items()}
@@ -92,13 +92,13 @@ def finish_toolprobe_calibrate(session: MeasureSession, ctx: MeasuringContext) -
         "number": n,
         "trigger": trigger,
         "disc_diameter": disc,
-        "axes": int(s.get("mt_ax", 133)),
-        "type": int(s.get("mt_type", 0)),
-        "dz": float(s.get("mt_dz", 2.0)),
+        "axes": int(s.mt_ax),
+        "type": int(s.mt_type),
+        "dz": float(s.mt_dz),
         "calibrated_length": True,
         "calibrated_diameter": bool(stored.get("calibrated_diameter")) or diameter_mode,
         "calibration_tool": int(tool["t"]),
-        "calibration_feed": float(feeds[-1]) if feeds else float(s.get("mt_fm", 100.0)),
+        "calibration_feed": float(feeds[-1]) if feeds else float(s.mt_fm),
         "calibration_override": float(ctx.feed_override),
         "calibrated_at": _now(),
     }
@@ -120,7 +120,7 @@ def latch_correction(session: MeasureSession, point: ToolPoint, record: dict, ct
     override = float(ctx.feed_override)
     stages = session.slots[0].raw[-len(point.feeds):]
     tips = [r.get("rec") if r.get("triggered") else None for r in stages]
-    cal_feed = float(record.get("calibration_feed") or ctx.settings.get("mt_fm", 100.0))
+    cal_feed = float(record.get("calibration_feed") or ctx.settings.mt_fm)
     cal_override = record.get("calibration_override")
     t, correction = latch_delay_correction(tips, point.touch.key, point.feeds, override, cal_feed,
                                            override if cal_override is None else float(cal_override))
@@ -128,26 +128,27 @@ def latch_correction(session: MeasureSession, point: ToolPoint, record: dict, ct
             "correction": correction}
 
 
-# --- tool length / radius (spec §7.3, math §14.4) -----------------------------------------------
+# --- tool length / radius (jog-measuring §7.3, measuring-math §14.4) -----------------------------------------------
 
-def finish_tool_measure(session: MeasureSession, ctx: MeasuringContext) -> tuple[dict, dict]:
+def finish_tool_measure(session: MeasureSession, ctx: MeasuringContext, points: list) -> tuple[dict, dict]:
     tool = active_tool(ctx)
-    point = _point(session, ToolPoint)
+    point = _point(session, points, ToolPoint)
     record = dict(ctx.extra.get("tool_probe") or {})
     trigger = {k: float(v) for k, v in (record.get("trigger") or {}).items()}
     name = "length" if point.kind == "length" else "radius"
     latch = latch_correction(session, point, record, ctx)
     measured = tool_point_value(point, trigger, ctx.plane) + latch["correction"]
     if measured <= 0.0:
-        raise MeasuringError(61303, f"Measured {name} {measured:.4f} mm is not positive: check the tool "
+        raise MeasuringError(alarms.SAFE_AREA, f"Measured {name} {measured:.4f} mm is not positive: check the tool "
                                     "probe calibration and the start position")
-    mode = session.params.get("compensation") or ctx.settings.get("tool_offset_mode", "geometry")
+    mode = session.params.get("compensation") or ctx.settings.tool_offset_mode
     wear = dict(tool.get("wear") or {})
     update = tool_offset_update(measured, float(tool.get(name, 0.0)), float(wear.get(name, 0.0)), mode)
     row = {k: v for k, v in tool.items() if k in TOOL_KEYS}
+    wear_before = {"length": float(wear.get("length", 0.0)), "radius": float(wear.get("radius", 0.0))}
     before = {"length": float(tool.get("length", 0.0)), "radius": float(tool.get("radius", 0.0)),
-              "wear": {"length": float(wear.get("length", 0.0)), "radius": float(wear.get("radius", 0.0))}}
-    row["wear"] = dict(before["wear"])
+              "wear": wear_before}
+    row["wear"] = dict(wear_before)
     row[name] = update["geometry"]
     row["wear"][name] = update["wear"]
     row = _validated_tool(row)
@@ -164,10 +165,3 @@ def finish_tool_measure(session: MeasureSession, ctx: MeasuringContext) -> tuple
     answer = {"result": result, "correction": {"target": f"T{t}", "before": before, "after": after},
               "activated": False, "setup_support": None}
     return answer, {"offset": None, "tool_update": (t, row)}
-
-
-FINISHERS = {
-    "toolprobe.calibrate": finish_toolprobe_calibrate,
-    "tool.length": finish_tool_measure,
-    "tool.diameter": finish_tool_measure,
-}

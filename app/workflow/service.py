@@ -7,97 +7,42 @@ transaction) -> activation. The service holds at most one session per machine.
 
 from __future__ import annotations
 
+import contextvars
+import math
 import threading
-from collections.abc import Callable
-from dataclasses import dataclass, field
-from typing import Protocol
+from collections.abc import Mapping
 
-from app.machine.protocol import Machine, MachineAlarm
+import numpy as np
+
+from app.errors import WorkflowError
+from app.machine.protocol import MachineAlarm
+from app.workflow.context import (
+    MEASURE_ONLY,
+    MeasuringContext,
+    MeasuringSetup,
+    OffsetOutcome,
+    ToolOffsetOutcome,
+    WorkflowEnv,
+)
 from app.workflow.executor import MotionAborted, StepExecutor
+from app.workflow.finish import setpoints_of
+from app.workflow.finish_tool_offset import target_label, tolerance_defaults, tool_target
 from app.workflow.session import MeasureSession, stored_point_to_api
-from engine.frames import Frame, FrameChain
-from engine.plan import run_program
-from engine.planes import Plane
-from engine.types import MeasuringError, ProbeRecord
+from app.workflow.tasks import TASKS, Category, Target, TaskSpec, task_spec
+from db import StorageUnavailable
+from engine import alarms
+from engine.plan import ideal_path, run_program
+from engine.strategy import Tolerance
+from engine.tasks import evaluate
+from engine.types import MeasuringError, averaged, translated
 
-MEASURE_ONLY = "measure_only"
-
-
-class WorkflowError(Exception):
-    """A request the workflow refuses; ``status`` is the HTTP status to answer with."""
-
-    def __init__(self, status: int, code: str, message: str, field: str | None = None):
-        super().__init__(message)
-        self.status, self.code, self.message, self.field = status, code, message, field
-
-
-@dataclass(frozen=True)
-class MeasuringContext:
-    """Snapshot of everything a measurement needs, taken when NC Start is pressed."""
-
-    active_offset: str                  # WO active while measuring ("G500", "G54", ..)
-    offsets: dict[str, Frame]           # every stored frame by name
-    frame_chain: FrameChain             # WCS -> BCS while measuring (settable = active_offset)
-    basic_names: tuple[str, ...]        # names of frame_chain.basic (BASIC_0, BASIC_1, ..)
-    plane: Plane
-    tool_length: float                  # NC offset length of the tool in the spindle
-    tool: dict | None                   # tool table row of the tool in the spindle
-    spindle_angle: float
-    feed_override: float
-    settings: dict                      # GUD settings (app.gud)
-    probe: ProbeRecord | None           # active workpiece probe record, None if no probe
-    probe_data: dict | None = None      # the stored probe record as JSON
-    extra: dict = field(default_factory=dict)
-
-    def chain(self) -> FrameChain:
-        return self.frame_chain
-
-    @staticmethod
-    def in_chain(target: str) -> bool:
-        """A basic frame (BASIC_REF, BASIC_n): always part of the active chain, unlike a WO."""
-        return target.startswith("BASIC")
-
-    def parent2bcs_of(self, target: str) -> Frame:
-        """Composition of the frames outside ``target`` (MCS side first)."""
-        if target in self.basic_names:
-            return self.frame_chain.parent2bcs_of_basic(self.basic_names.index(target))
-        if self.in_chain(target):           # BASIC_REF, the SETFRAME: nothing outside it
-            return Frame.identity()
-        return self.frame_chain.below_settable
-
-
-class WorkflowEnv(Protocol):
-    """What the app provides to the workflow (implemented in app.services)."""
-
-    machine: Machine
-
-    def measuring_context(self) -> MeasuringContext: ...
-
-    def commit_measurement(self, *, offset: tuple[str, dict, dict, dict] | None, log_entry: dict,
-                           probe_update: tuple[int, dict] | None = None,
-                           tool_update: tuple[int, dict] | None = None,
-                           tool_probe_update: tuple[int, dict] | None = None) -> int:
-        """Write offset (name, before, after, detail) + audit + log (+ data records) in one transaction."""
-
-    def activate(self, name: str) -> None: ...
-
-    def refresh_frames(self) -> None:
-        """Re-send the active frame chain to the machine (after a basic frame changed)."""
-
-    def post_alarm(self, code: int, text: str) -> None: ...
-
-
-# A finisher turns the stored points into (answer, commit kwargs) for one task family.
-Finisher = Callable[[MeasureSession, MeasuringContext], tuple[dict, dict]]
+__all__ = ["MEASURE_ONLY", "MeasuringContext", "WorkflowEnv", "WorkflowError", "WorkflowService"]
 
 
 class WorkflowService:
-    def __init__(self, env: WorkflowEnv, finishers: dict[str, Finisher],
-                 plan_module, task_points: dict[str, int]):
+    def __init__(self, env: WorkflowEnv, tasks: Mapping[str, TaskSpec] = TASKS):
         self._env = env
-        self._finishers = finishers
-        self._plan = plan_module
-        self._task_points = task_points
+        self._tasks = tasks
         self._lock = threading.Lock()
         self._session: MeasureSession | None = None
 
@@ -111,19 +56,34 @@ class WorkflowService:
             raise WorkflowError(404, "no_session", f"measuring session {session_id} does not exist")
         return self._session
 
-    def create(self, task: str, params: dict, target: str | None = None) -> MeasureSession:
-        if task not in self._task_points:
-            raise WorkflowError(400, "unknown_task", f"unknown measuring task {task!r}", "task")
-        ctx = self._env.measuring_context()
+    def spec(self, task: str) -> TaskSpec:
+        spec = self._tasks.get(task) if isinstance(task, str) else None
+        return spec if spec is not None else task_spec(task)     # unknown: 400 naming "task"
+
+    @staticmethod
+    def _validate(spec: TaskSpec, params: dict, ctx: MeasuringSetup) -> dict:
         try:
-            normalised = self._plan.validate_params(task, dict(params or {}), ctx.plane)
+            return spec.validate(dict(params or {}), ctx.plane)
         except ValueError as exc:
             raise WorkflowError(400, "invalid_param", str(exc), getattr(exc, "field", None)) from exc
-        self._check_rotary_axis(normalised)
-        chosen = target or ctx.active_offset
-        if chosen == "G500":
-            chosen = MEASURE_ONLY if task.split(".")[0] not in ("probe", "tool", "toolprobe") else chosen
-        self._check_target(task, chosen, ctx)
+
+    def create(self, task: str, params: dict, target: str | dict | None = None) -> MeasureSession:
+        spec = self.spec(task)
+        ctx = self._env.measuring_setup()
+        wanted = ctx.settings.measuring_wo           # _JM_I[4]: the WO active while measuring (jog-measuring §4.4)
+        if wanted != "active" and wanted != ctx.active_offset and not (self._session and self._session.running):
+            self._env.activate(wanted)
+            ctx = self._env.measuring_setup()
+        self._check_machine_kind(spec)
+        if spec.target_in_params:
+            normalised, chosen = self._params_with_target(spec, params, target, ctx)
+        else:
+            normalised = self._validate(spec, params, ctx)
+            self._check_rotary_axis(normalised)
+            chosen = target or ctx.active_offset
+            if chosen == "G500" and spec.corrects_zero_offset:
+                chosen = MEASURE_ONLY
+            chosen = self._check_target(spec, chosen, normalised, ctx)
         # never wait for a running NC Start (it holds the lock for the whole measurement)
         if not self._lock.acquire(blocking=False):
             raise WorkflowError(409, "busy", "a measurement is running; press Reset first")
@@ -131,13 +91,35 @@ class WorkflowService:
             if self._session is not None and self._session.running:
                 raise WorkflowError(409, "busy", "a measurement is running; press Reset first")
             self._session = MeasureSession.create(task, normalised, chosen, ctx.active_offset,
-                                                  self._task_points[task])
+                                                  spec.points_of(normalised))
             return self._session
         finally:
             self._lock.release()
 
+    def _check_machine_kind(self, spec: TaskSpec) -> None:
+        """The lathe tasks need a lathe, the milling tasks a milling machine (turning.md §10.1)."""
+        lathe = getattr(self._env.machine, "kind", "mill") == "lathe"
+        if spec.lathe and not lathe:
+            raise WorkflowError(409, "not_a_lathe", f"{spec.name} measures on a lathe; this machine is a "
+                                "milling machine", "task")
+        if lathe and not spec.lathe:
+            raise WorkflowError(409, "lathe", f"{spec.name} is a milling task; on the lathe use the lathe tasks "
+                                "(lathe.*)", "task")
+
+    def _params_with_target(self, spec: TaskSpec, params: dict, target, ctx: MeasuringSetup):
+        """Lathe tasks: ``target`` is one of the params the engine validates (turning.md §10.2); a
+        zero offset must be one of the stored frames. -> (params, session target)."""
+        params = dict(params or {})
+        if target is not None:
+            params["target"] = target
+        normalised = self._validate(spec, params, ctx)
+        chosen = normalised.get("target")
+        if isinstance(chosen, str) and chosen != MEASURE_ONLY and chosen not in ctx.offset_names:
+            raise WorkflowError(400, "invalid_target", f"unknown zero offset {chosen!r}", "target")
+        return normalised, chosen
+
     def _check_rotary_axis(self, params: dict) -> None:
-        """A rotary-axis angle correction names a configured rotary axis (spec §2.3 [I])."""
+        """A rotary-axis angle correction names a configured rotary axis (jog-measuring §2.3 [I])."""
         axis = params.get("angle_correction")
         if axis in (None, "rotation", "none"):
             return
@@ -146,41 +128,74 @@ class WorkflowService:
                                 f"angle_correction: {axis} is not a rotary axis of this machine",
                                 "angle_correction")
 
-    # params that only enter the calculation may change while points are stored (spec §3.1 [I])
+    # params that only enter the calculation may change while points are stored (jog-measuring §3.1 [I])
     EDITABLE_WHILE_STORED = frozenset({"setpoint", "setpoint_angle", "angle_correction", "set_p1", "target"})
 
-    def update_params(self, session_id: str, params: dict, target: str | None = None) -> MeasureSession:
+    def update_params(self, session_id: str, params: dict, target: str | dict | None = None) -> MeasureSession:
         """Change setpoints/target of an open session until Calculate; probing params stay locked."""
         session = self.get(session_id)
         if session.running:
             raise WorkflowError(409, "busy", "a measurement is running")
-        ctx = self._env.measuring_context()
-        try:
-            normalised = self._plan.validate_params(session.task, dict(params or {}), ctx.plane)
-        except ValueError as exc:
-            raise WorkflowError(400, "invalid_param", str(exc), getattr(exc, "field", None)) from exc
+        ctx = self._env.measuring_setup()
+        spec = self.spec(session.task)
+        if spec.target_in_params:
+            params = dict(params or {})
+            if target is None and "target" not in params and session.target is not None:
+                target = session.target
+            session.params, session.target = self._params_with_target(spec, params, target, ctx)
+            return session
+        normalised = self._validate(spec, params, ctx)
         if any(s.stored for s in session.slots):
             for key in set(normalised) | set(session.params):
                 if key not in self.EDITABLE_WHILE_STORED and normalised.get(key) != session.params.get(key):
                     raise WorkflowError(409, "locked", f"{key} is locked while a point is stored", key)
         self._check_rotary_axis(normalised)
-        chosen = target or session.target
-        self._check_target(session.task, chosen, ctx)
+        chosen = self._check_target(spec, target or session.target, normalised, ctx)
         session.params, session.target = normalised, chosen
         return session
 
-    def _check_target(self, task: str, target: str, ctx: MeasuringContext) -> None:
-        if task.split(".")[0] in ("probe", "tool", "toolprobe"):
-            return
-        if target != MEASURE_ONLY and target not in ctx.offsets:
+    def _check_target(self, spec: TaskSpec, target, params: dict, ctx: MeasuringSetup):
+        """The normalised target: a WO name, or a tool offset object (design.md §9.3)."""
+        if isinstance(target, dict):
+            if Target.TOOL_OFFSET not in spec.targets:
+                raise WorkflowError(400, "invalid_target", f"{spec.name} does not correct tools: "
+                                    "choose a zero offset", "target")
+            try:
+                normalised = tool_target(target)
+                Tolerance.from_params(params.get("tolerance"), tolerance_defaults(ctx.settings))
+            except ValueError as exc:
+                text = str(exc)
+                field = text.split(":", 1)[0] if text.startswith("target.") else "tolerance"
+                raise WorkflowError(400, "invalid_target" if field.startswith("target") else "invalid_param",
+                                    text, field) from None
+            return normalised
+        if "tolerance" in params:
+            raise WorkflowError(400, "invalid_param", "tolerance: only for a tool offset target", "tolerance")
+        if not spec.corrects_zero_offset:
+            return target
+        if not isinstance(target, str) or (target != MEASURE_ONLY and target not in ctx.offset_names):
             raise WorkflowError(400, "invalid_target", f"unknown zero offset {target!r}", "target")
+        if (target.startswith("BASIC_") and target != "BASIC_REF"
+                and ctx.settings.compensation_choice != "extended"):          # jog-measuring §4.1/jog-measuring §4.2, _JM_I[5]
+            raise WorkflowError(400, "invalid_target", f"{target}: a basic frame is a target of the extended "
+                                "compensation choice only (setting Compensation choice = extended)", "target")
+        return target
 
     def delete(self, session_id: str) -> None:
-        """Leave the screen: abort and discard stored points (spec §3.1)."""
+        """Leave the screen: abort and discard stored points (jog-measuring §3.1)."""
         session = self.get(session_id)
         if session.running:
             self._env.machine.reset()
         self._session = None
+
+    def discard_points(self, reason: str) -> None:
+        """The stored points lost their meaning (tool change, scenario load): discard them and
+        let the session say why (design.md §9.1)."""
+        session = self._session
+        if session is None or session.running or not any(s.stored for s in session.slots):
+            return
+        session.clear_points()
+        session.notice = f"{reason}: the stored points were discarded, measure them again"
 
     def invalidate(self, session_id: str, n: int) -> MeasureSession:
         session = self.get(session_id)
@@ -194,131 +209,269 @@ class WorkflowService:
         return session
 
     # --- NC Start -----------------------------------------------------------------------
-    def start(self, session_id: str, point: int | None = None) -> dict:
+    def start(self, session_id: str, point: int | None = None, wait: bool = True) -> dict:
+        """NC Start: probe point ``point`` (default: the lowest unstored). With ``wait`` False the
+        measurement runs in the background (the answer is 202-style: the session, ``running``
+        true, its ``progress``); the session's ``answer``/``alarm`` tell how it ended."""
         session = self.get(session_id)
         if not self._lock.acquire(blocking=False):
             raise WorkflowError(409, "busy", "a measurement is already running")
         try:
-            if session.running or self._env.machine.status().busy:
-                raise WorkflowError(409, "busy", "the machine is moving")
-            n = point if point is not None else session.next_point()
-            if n is None:
-                if session.single_point:
-                    n = 1
-                else:
-                    raise WorkflowError(409, "all_stored",
-                                        "all points are stored: press Calculate or invalidate a point")
-            try:
-                slot = session.slot(n)
-            except KeyError:
-                raise WorkflowError(404, "no_point", f"point P{n} does not exist for {session.task}",
-                                    "point") from None
-            alarms = [a for a in self._env.machine.status().alarms]
-            if alarms:
-                raise WorkflowError(409, "alarm", f"{alarms[-1].code} {alarms[-1].text}: press Reset first")
-            session.running = True
-            session.last_alarm = None
-            ctx = self._env.measuring_context()
-            if session.task.split(".")[0] not in ("tool", "toolprobe") and ctx.probe is None:
-                raise WorkflowError(409, "alarm", "61309 Check probe type: the tool in the spindle is "
-                                                  "not a 3D probe (type 710); change to the probe first")
-            session.warnings = self._warnings(session, ctx)
-            if self._refuse_override(ctx):
-                raise WorkflowError(409, "override_mismatch", session.warnings[-1])
-            try:
-                stored, raw = self._measure_point(session, n, ctx)
-            except (MachineAlarm, MeasuringError, MotionAborted) as exc:
-                slot.point, slot.raw = None, []
-                session.last_alarm = self._alarm_of(exc)
-                if isinstance(exc, MeasuringError):
-                    self._env.post_alarm(exc.alarm, exc.message)
-                raise WorkflowError(409, "alarm", f"{session.last_alarm['code']} {session.last_alarm['text']}") from exc
-            slot.point, slot.raw = stored, raw
-            session.running = False
-            answer = {"session": session.to_api(), "point": slot.to_api()}
-            if session.single_point:
-                answer.update(self._finish(session, ctx))
-            return answer
-        finally:
+            spec, n, ctx = self._prepare_start(session, point)
+        except BaseException:
             session.running = False
             self._lock.release()
+            raise
+        if wait:
+            try:
+                return self._run_point(session, spec, n, ctx, count_steps=False)
+            finally:
+                session.running = False
+                self._lock.release()
+
+        def background() -> None:
+            try:
+                self._run_point(session, spec, n, ctx)
+            except WorkflowError:
+                pass                    # the session's alarm says what happened
+            finally:
+                session.running = False
+                self._lock.release()
+
+        context = contextvars.copy_context()        # who pressed NC Start acts in the thread too (audit)
+        threading.Thread(target=context.run, args=(background,), name=f"nc-start-{session.id}", daemon=True).start()
+        return {"session": session.to_api(), "accepted": True}
+
+    def _prepare_start(self, session: MeasureSession, point: int | None):
+        """Every refusal of NC Start before anything moves; marks the session running."""
+        if session.running or self._env.machine.status().busy:
+            raise WorkflowError(409, "busy", "the machine is moving")
+        n = point if point is not None else session.next_point()
+        if n is None:
+            if not session.single_point:
+                raise WorkflowError(409, "all_stored", "all points are stored: press Calculate or invalidate a point")
+            n = 1
+        try:
+            session.slot(n)
+        except KeyError:
+            raise WorkflowError(404, "no_point", f"point P{n} does not exist for {session.task}", "point") from None
+        pending = self._env.machine.status().alarms
+        if pending:
+            raise WorkflowError(409, "alarm", f"{pending[-1].code} {pending[-1].text}: press Reset first")
+        spec = self.spec(session.task)
+        ctx = self._env.measuring_context()
+        if spec.needs_probe and ctx.probe is None:
+            raise WorkflowError(409, "alarm", f"{alarms.PROBE_TYPE.number} {alarms.PROBE_TYPE.text}: the tool in "
+                                              "the spindle is not a 3D probe (type 710); change to the probe first")
+        self._check_probe_geometry(spec, ctx)
+        warnings = self._warnings(spec, ctx)
+        if self._refuse_override(ctx):
+            raise WorkflowError(409, "override_mismatch", warnings[-1])
+        session.warnings = warnings
+        session.running = True
+        session.last_alarm = None
+        session.notice = None
+        session.progress = {"point": n, "step": 0, "steps": None, "label": ""}
+        return spec, n, ctx
+
+    def _run_point(self, session: MeasureSession, spec: TaskSpec, n: int, ctx: MeasuringContext,
+                   count_steps: bool = True) -> dict:
+        slot = session.slot(n)
+        session.repetitions = 0
+        while True:
+            try:
+                stored, raw = self._measure_point(spec, session, n, ctx, count_steps)
+            except (MachineAlarm, MeasuringError, MotionAborted) as exc:
+                slot.point, slot.raw, slot.context = None, [], None
+                raise self._alarm(session, exc) from exc
+            finally:
+                session.progress = None
+            slot.point, slot.raw, slot.context = stored, raw, ctx
+            answer = {"session": session.to_api(), "point": slot.to_api()}
+            if not spec.single_point:
+                return answer
+            answer.update(self._finish(session, spec))
+            if not answer.get("_repeat"):
+                answer.pop("_repeat", None)
+                if session.params.get("verify") and answer.get("activated"):
+                    answer["verify"] = self._verify(spec, session, n)
+                    session.last = {**(session.last or {}), "verify": answer["verify"]}
+                return answer
+            session.repetitions += 1        # the repeat rule (_CBIT[0], measuring-math §3.6): measure again
+
+    def _verify(self, spec: TaskSpec, session: MeasureSession, n: int) -> dict:
+        """``params.verify`` (design.md §9.8): probe the point again in the WCS just written and
+        activated, and report what remains of the deviation from the setpoints (nothing written)."""
+        ctx = self._env.measuring_context()
+        try:
+            point, _raw = self._measure_point(spec, session, n, ctx, count_steps=False)
+        except (MachineAlarm, MeasuringError, MotionAborted) as exc:
+            return {"ok": False, "alarm": self._alarm_of(exc)}
+        finally:
+            session.progress = None
+        result = evaluate(session.task, session.params, [point], ctx.plane, ctx.probe)
+        setpoints = setpoints_of(session, ctx.plane.axes)
+        remaining = {axis: float(value) - setpoints.get(axis, 0.0) for axis, value in result.fix.position.items()}
+        return {"ok": True, "result": result.values, "remaining": remaining, "wcs": ctx.active_offset}
+
+    def _alarm(self, session: MeasureSession, exc: Exception) -> WorkflowError:
+        """The alarm that ended the point: kept in the session, shown by the machine, logged."""
+        session.last_alarm = self._alarm_of(exc)
+        if isinstance(exc, MeasuringError):
+            self._env.post_alarm(exc.alarm, exc.message)
+        self._log_failure(session)
+        return WorkflowError(409, "alarm", f"{session.last_alarm['code']} {session.last_alarm['text']}")
+
+    def _log_failure(self, session: MeasureSession) -> None:
+        """A failed attempt is a log entry too (status "alarm NNNNN"): which point, which step, why.
+        Nothing else is written; a log that cannot be written leaves the alarm standing alone."""
+        progress = session.progress or {}
+        alarm = session.last_alarm or {}
+        entry = {
+            "task": session.task, "params": session.params, "measuring_wo": session.measuring_wo,
+            "target": target_label(session.target) if isinstance(session.target, dict) else session.target,
+            "status": f"alarm {alarm.get('code', '')}".strip(),
+            "result": {"alarm": {**alarm, "point": progress.get("point"), "step": progress.get("label") or None}},
+            "points": {f"P{s.n}": stored_point_to_api(s.point) for s in session.slots},
+            "warnings": session.warnings,
+        }
+        try:
+            self._env.commit_measurement(log_entry=entry)
+        except StorageUnavailable:
+            pass
 
     @staticmethod
     def _alarm_of(exc: Exception) -> dict:
         if isinstance(exc, MachineAlarm):
-            return {"code": exc.alarm.code, "text": exc.alarm.text}
-        if isinstance(exc, MeasuringError):
-            return {"code": exc.alarm, "text": exc.message}
-        return {"code": 0, "text": "Measurement aborted by Reset"}
+            code, text = exc.alarm.code, exc.alarm.text
+        elif isinstance(exc, MeasuringError):
+            code, text = exc.alarm, exc.message
+        else:
+            return {"code": 0, "text": "Measurement aborted by Reset", "remedy": "Start the measurement again."}
+        definition = alarms.by_number(code)
+        return {"code": code, "text": text, "remedy": definition.remedy if definition else ""}
 
-    def _warnings(self, session: MeasureSession, ctx: MeasuringContext) -> list[str]:
+    MAX_PROBE_TILT_DEG = 45.0     # beyond, the plane's infeed is not the spindle axis (design.md §9.8)
+
+    def _check_probe_geometry(self, spec: TaskSpec, ctx: MeasuringContext) -> None:
+        """Refusals before motion (design.md §9.8, measuring-math §1.7): a plane whose infeed axis
+        is not the spindle axis (the tool length would act along the wrong axis), a probe not
+        calibrated in the active plane (61341), trigger values of another spindle orientation."""
+        if not spec.needs_probe:
+            return
+        status = self._env.machine.status()
+        tool_axis = np.asarray(getattr(status, "tool_axis", (0.0, 0.0, 1.0)), dtype=float)
+        infeed = ctx.chain().wcs2bcs.dir_child2parent(ctx.plane.infeed_unit)
+        tilt = math.degrees(math.acos(max(-1.0, min(1.0, float(tool_axis @ infeed)))))
+        if tilt > self.MAX_PROBE_TILT_DEG:
+            axis = "XYZ"[int(np.argmax(np.abs(tool_axis)))]
+            raise WorkflowError(409, "alarm", f"{alarms.PROBE_PLANE.number} {alarms.PROBE_PLANE.text}: the infeed "
+                                f"axis {ctx.plane.infeed} of {ctx.plane.name} is not the spindle axis ({axis}); "
+                                f"measure in the plane whose infeed is {axis}, or align the head first")
+        data = ctx.probe_data or {}
+        if spec.category != Category.WORKPIECE or not data.get("calibrated_radius"):
+            return
+        planes = data.get("calibrated_planes") or []
+        if planes and ctx.plane.name not in planes:
+            raise WorkflowError(409, "alarm", f"{alarms.NOT_CALIBRATED_IN_PLANE.number} "
+                                f"{alarms.NOT_CALIBRATED_IN_PLANE.text}: calibrated in {', '.join(planes)}, "
+                                f"measuring in {ctx.plane.name}: calibrate the probe in {ctx.plane.name}")
+        angle = data.get("calibrated_spindle_angle")
+        if ctx.settings.pretravel_frame == "probe" and angle is not None:
+            off = abs((ctx.spindle_angle - float(angle) + 180.0) % 360.0 - 180.0)
+            if off > 1e-6:
+                raise WorkflowError(409, "spindle_orientation",
+                                    f"The spindle is at {ctx.spindle_angle:g}°, the probe was calibrated at "
+                                    f"{float(angle):g}°: its pre-travel turns with it. Position the spindle "
+                                    f"(SPOS {float(angle):g}) first")
+
+    @staticmethod
+    def _warnings(spec: TaskSpec, ctx: MeasuringContext) -> list[str]:
         warnings: list[str] = []
         probe = ctx.probe
-        if session.task.split(".")[0] in ("tool", "toolprobe"):
+        if not spec.needs_probe or probe is None:
             return warnings
-        if probe is None:
-            return warnings
-        if session.task != "probe.radius" and not probe.calibrated_radius:
+        if spec.name != "probe.radius" and not probe.calibrated_radius:
             warnings.append("Probe not calibrated (radius): results carry its eccentricity and pre-travel")
         if (probe.calibration_override is not None
                 and abs(probe.calibration_override - ctx.feed_override) > 1e-9
-                and not session.task.startswith("probe.")):
+                and spec.category == Category.WORKPIECE):
             warnings.append(f"Feed override {ctx.feed_override:g} % differs from the calibration's "
-                            f"{probe.calibration_override:g} %: set the same override (spec §1.7)")
+                            f"{probe.calibration_override:g} %: set the same override (jog-measuring §1.7)")
         return warnings
 
     def _refuse_override(self, ctx: MeasuringContext) -> bool:
         probe = ctx.probe
-        return bool(ctx.settings.get("override_mismatch") == "refuse" and probe is not None
+        return bool(ctx.settings.override_mismatch == "refuse" and probe is not None
                     and probe.calibration_override is not None
                     and abs(probe.calibration_override - ctx.feed_override) > 1e-9)
 
-    def _measure_point(self, session: MeasureSession, n: int, ctx: MeasuringContext):
-        plan_ctx = self._plan.context_from(ctx, session)
+    def _measure_point(self, spec: TaskSpec, session: MeasureSession, n: int, ctx: MeasuringContext,
+                       count_steps: bool = True):
+        plan_ctx = spec.plan_context(ctx, session.params)        # planning.context_from; a lathe's own
+        release = getattr(self._env, "release_jog", None)
+        if callable(release):        # a jog's dead-man must never stop the measurement (MachineService)
+            release()
         executor = StepExecutor(self._env.machine, ctx.chain().wcs2bcs, ctx.tool_length,
-                                ctx.plane.infeed_unit)
-        coords = "MCS" if session.task.split(".")[0] in ("tool", "toolprobe") else "WCS"
-        start = executor.current(coords)
-        program = self._plan.point_program(session.task, session.params, n, start, plan_ctx)
+                                ctx.plane.infeed_unit, tip=spec.tool_tip(ctx))
+        start = executor.current(spec.coords_for(session.params, plan_ctx))
+        repeats = spec.repeats(session.params)        # _NMSP, measuring-math §1.4
+        # the step count for the progress of a background NC Start (a waiting caller sees none)
+        steps = repeats * len(ideal_path(spec.program(session.params, n, start, plan_ctx), start)) \
+            if count_steps else None
         raw: list[dict] = []
+        # pass: the repetition of the point's program (_NMSP), shown beside point and step
+        progress = {"point": n, "step": 0, "steps": steps, "label": "", "pass": 1, "passes": repeats}
+        session.progress = progress
 
         def execute(step):
+            current = session.progress
+            assert current is not None, "set above for the run, cleared only after it (_run_point, _verify)"
+            done = current["step"] + 1
+            session.progress = {**progress, "step": min(done, steps) if steps else done,
+                                "label": getattr(step, "label", "")}
             latch = executor.run(step)
             if latch is not None:      # the raw latches go into the log
+                # tip_mcs: the NC's ball centre / tool tip in MCS, where the machine views draw the touch
+                tip = executor.tip_conversion.tip_in_mcs(latch.latched_mcs) if latch.latched_mcs is not None else None
                 raw.append({"triggered": latch.triggered, "rec": _floats(latch.rec),
-                            "mcs": _floats(latch.latched_mcs)})
+                            "mcs": _floats(latch.latched_mcs), "tip_mcs": _floats(tip)})
             return latch
 
-        return run_program(program, execute), raw
+        points = []
+        for k in range(repeats):
+            progress["pass"] = k + 1
+            points.append(run_program(spec.program(session.params, n, start, plan_ctx), execute))
+        return averaged(points), raw
 
     # --- Calculate ----------------------------------------------------------------------
     def calculate(self, session_id: str) -> dict:
         session = self.get(session_id)
-        if session.running:
-            raise WorkflowError(409, "busy", "a measurement is running")
-        if session.single_point:
-            raise WorkflowError(409, "single_point", "this task computes on NC Start; there is no Calculate")
-        if not session.can_calculate:
-            missing = [s.n for s in session.slots if not s.stored]
-            raise WorkflowError(409, "points_missing",
-                                "Calculate needs all points stored; missing " + ", ".join(f"P{n}" for n in missing))
-        ctx = self._env.measuring_context()
-        return self._finish(session, ctx)
-
-    def _finish(self, session: MeasureSession, ctx: MeasuringContext) -> dict:
-        family = session.task.split(".")[0]
-        finisher = self._finishers.get(session.task) or self._finishers.get(family) \
-            or self._finishers["workpiece"]
+        if not self._lock.acquire(blocking=False):      # one Calculate or NC Start at a time
+            raise WorkflowError(409, "busy", "a measurement or Calculate is running")
         try:
-            answer, commit = finisher(session, ctx)
+            if session.running:
+                raise WorkflowError(409, "busy", "a measurement is running")
+            if session.single_point:
+                raise WorkflowError(409, "single_point", "this task computes on NC Start; there is no Calculate")
+            if not session.can_calculate:
+                missing = [s.n for s in session.slots if not s.stored]
+                raise WorkflowError(409, "points_missing", "Calculate needs all points stored; missing "
+                                    + ", ".join(f"P{n}" for n in missing))
+            return self._finish(session, self.spec(session.task))
+        finally:
+            self._lock.release()
+
+    def _finish(self, session: MeasureSession, spec: TaskSpec) -> dict:
+        ctx, points = evaluation_inputs(session)
+        try:
+            answer, commit = spec.finish(session, ctx, points)
         except MeasuringError as exc:
-            session.last_alarm = {"code": exc.alarm, "text": exc.message}
-            self._env.post_alarm(exc.alarm, exc.message)
-            raise WorkflowError(409, "alarm", f"{exc.alarm} {exc.message}") from exc
+            raise self._alarm(session, exc) from exc
         log_entry = {
             "task": session.task,
             "params": session.params,
-            "target": session.target,
+            "target": target_label(session.target) if isinstance(session.target, dict) else session.target,
             "measuring_wo": session.measuring_wo,
             "raw": {f"P{s.n}": s.raw for s in session.slots},
             "points": {f"P{s.n}": stored_point_to_api(s.point) for s in session.slots},
@@ -328,22 +481,66 @@ class WorkflowService:
             "warnings": session.warnings,
             "status": "ok",
         }
-        log_id = self._env.commit_measurement(log_entry=log_entry, **commit)
+        try:
+            log_id, outcome = self._env.commit_measurement(log_entry=log_entry, **commit)
+        except MeasuringError as exc:          # decided inside the transaction: nothing was written
+            raise self._alarm(session, exc) from exc
+        if isinstance(outcome, OffsetOutcome):
+            answer.update(outcome.answer)
+        elif isinstance(outcome, ToolOffsetOutcome):
+            answer["result"] = {**answer["result"], **outcome.result}
+            answer["correction"] = outcome.correction
+            answer["_repeat"] = outcome.repeat
         answer["log_id"] = log_id
         activate = answer.pop("_activate", None)
         if activate:
             self._env.activate(activate)
-        elif answer.get("_refresh_frames"):
+        elif answer.pop("_refresh_frames", None):
             self._env.refresh_frames()
-        answer.pop("_refresh_frames", None)
         answer["warnings"] = list(session.warnings)
-        session.clear_points()        # spec §3.1 step 6: ready for a new measurement
+        if answer.get("_repeat"):
+            return answer                # the same point is measured again (the repeat rule)
+        answer.pop("_repeat", None)
+        session.clear_points()        # jog-measuring §3.1 step 6: ready for a new measurement
         session.last = answer
         return answer
 
 
-def points_of(session: MeasureSession) -> list:
-    return [s.point for s in session.slots]
+def evaluation_inputs(session: MeasureSession) -> tuple[MeasuringContext, list]:
+    """The context to evaluate in (P1's) and every stored point in its WCS (design.md §9.1).
+
+    Points taken in measuring systems that differ by a translation (another WO activated, a WO
+    edited between the points) are moved into P1's WCS through the BCS. A change of the
+    rotation, the plane, the probe record or the tool length between the points cannot be made
+    good: Calculate is refused (409 ``context_changed``) and nothing is written."""
+    slots = session.slots
+    first = slots[0].context
+    points = [slots[0].point]
+    for slot in slots[1:]:
+        ctx = slot.context
+        if ctx is None or first is None:
+            points.append(slot.point)
+            continue
+        reason = _changed(first, ctx)
+        if reason:
+            raise WorkflowError(409, "context_changed", f"{reason} between P1 and P{slot.n}: "
+                                "measure the points again (invalidate them) before Calculate")
+        between = first.chain().wcs2bcs.inverse().compose(ctx.chain().wcs2bcs)   # P_n's WCS -> P1's WCS
+        assert slot.point is not None, "a slot's context is stored together with its point"
+        points.append(translated(slot.point, between.translation))
+    return first, points
+
+
+def _changed(first: MeasuringContext, other: MeasuringContext) -> str | None:
+    if other.plane.name != first.plane.name:
+        return "The working plane changed"
+    if other.probe != first.probe or other.tool_length != first.tool_length \
+            or (other.tool or {}).get("t") != (first.tool or {}).get("t"):
+        return "The probe data or the tool changed"
+    r1, r2 = first.chain().wcs2bcs.rotation, other.chain().wcs2bcs.rotation
+    if float(np.max(np.abs(r1 - r2))) > 1e-12 or first.chain().wcs2bcs.rotary != other.chain().wcs2bcs.rotary:
+        return "The rotation of the measuring zero offset changed"
+    return None
 
 
 def _floats(v) -> list[float] | None:

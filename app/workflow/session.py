@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import uuid
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -47,6 +48,7 @@ class PointSlot:
     n: int
     point: StoredPoint | None = None
     raw: list[dict] = field(default_factory=list)   # raw latches of the probing moves, for the log
+    context: Any = None     # the MeasuringContext the point was taken in (design.md §9.1)
 
     @property
     def stored(self) -> bool:
@@ -60,7 +62,7 @@ class PointSlot:
 class MeasureSession:
     task: str
     params: dict
-    target: str
+    target: str | dict                  # a WO name, or a tool offset (design.md §9.3)
     measuring_wo: str
     slots: list[PointSlot]
     id: str = field(default_factory=lambda: uuid.uuid4().hex[:12])
@@ -68,9 +70,13 @@ class MeasureSession:
     last: dict | None = None            # last calculate answer
     last_alarm: dict | None = None
     warnings: list[str] = field(default_factory=list)
+    progress: dict | None = None        # {"point", "step", "steps", "label"} while NC Start runs
+    notice: str | None = None           # why stored points were discarded (tool change, scenario)
+    repetitions: int = 0                # repetitions made under the repeat rule (_CBIT[0], measuring-math §3.6)
 
     @classmethod
-    def create(cls, task: str, params: dict, target: str, measuring_wo: str, n_points: int) -> MeasureSession:
+    def create(cls, task: str, params: dict, target: str | dict, measuring_wo: str, n_points: int
+               ) -> MeasureSession:
         return cls(task=task, params=params, target=target, measuring_wo=measuring_wo,
                    slots=[PointSlot(n) for n in range(1, n_points + 1)])
 
@@ -87,7 +93,7 @@ class MeasureSession:
         return not self.single_point and all(s.stored for s in self.slots)
 
     def next_point(self) -> int | None:
-        """The lowest-numbered point not stored (spec §3.1 [I])."""
+        """The lowest-numbered point not stored (jog-measuring §3.1 [I])."""
         for slot in self.slots:
             if not slot.stored:
                 return slot.n
@@ -100,16 +106,14 @@ class MeasureSession:
 
     def invalidate(self, n: int) -> None:
         slot = self.slot(n)
-        slot.point = None
-        slot.raw = []
+        slot.point, slot.raw, slot.context = None, [], None
 
     def clear_points(self) -> None:
         for slot in self.slots:
-            slot.point = None
-            slot.raw = []
+            slot.point, slot.raw, slot.context = None, [], None
 
     def plc_byte(self) -> int:
-        """DB19.DBB43 bits 4..7: point n measured and stored (spec §3.2)."""
+        """DB19.DBB43 bits 4..7: point n measured and stored (jog-measuring §3.2)."""
         return sum(1 << (3 + s.n) for s in self.slots if s.stored)
 
     def to_api(self) -> dict:
@@ -123,6 +127,10 @@ class MeasureSession:
             "next_point": self.next_point(),
             "can_calculate": self.can_calculate,
             "busy": self.running,
+            "running": self.running,
+            "progress": dict(self.progress) if self.progress else None,
+            "answer": self.last,
+            "notice": self.notice,
             "plc_dbb43": self.plc_byte(),
             "warnings": list(self.warnings),
             "alarm": self.last_alarm,

@@ -1,21 +1,21 @@
-"""Set-up support after measuring and chain measuring (spec/jog-measuring.md §6.1, §6.2, §6.3).
+"""Set-up support after measuring and chain measuring (spec/jog-measuring.md §6.1, jog-measuring §6.2, jog-measuring §6.3).
 
 ``finish_workpiece`` puts ``setup_support`` into the calculate answer when the correction went
 into a WO not active while measuring, tilts the infeed axis, or needs a rotary axis positioned.
 This module shows that answer as the activation screen (``screen_model``) and carries it out on
 NC Start (``carry_out``):
 
-- activate: select the corrected WO in the channel (no axis motion, spec §6.2 example 1). The
-  activated WO becomes the WO of the next measurement (chain measuring, spec §6.1, ``_JM_I[6]``).
+- activate: select the corrected WO in the channel (no axis motion, jog-measuring §6.2 example 1). The
+  activated WO becomes the WO of the next measurement (chain measuring, jog-measuring §6.1, ``_JM_I[6]``).
 - re-align: CYCLE800-like swivel so that the tool axis is parallel to the new infeed axis. On a
   machine without swivel kinematics nothing moves; the screen says so and measuring continues
   with the probe as it is (a ball probe measures correctly obliquely in the tilted WCS).
-- retract first (spec §11 Q9): only before a swivel, up along the tool axis to the top limit.
+- retract first (jog-measuring §11 Q9): only before a swivel, up along the tool axis to the top limit.
   The manual's toggle field 3 says "空运行" (dry run / traverse); the spec's function is kept.
 - with a swivel head (scenario ``machine.kinematics``), NC Start activates first, then retracts
   and swivels the head so that the tool axis is ∥ the infeed axis of the (new) active WCS; the
-  WCS follows the kinematics (app.workflow.executor.length_axis), measuring goes on in the tilted WCS.
-- position rotary axis (spec §2.5.2, §11 Q8): turn the axis by the correction's ``rotary_move``
+  WCS follows the kinematics (engine.coords.length_axis), measuring goes on in the tilted WCS.
+- position rotary axis (jog-measuring §2.5.2, jog-measuring §11 Q8): turn the axis by the correction's ``rotary_move``
   from where it stood while measuring, so that the edge lies at the setpoint angle.
 
 Decisions: the "activate" toggle is offered in every case (the WO active while measuring was
@@ -27,8 +27,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from app.errors import AlarmError
-from app.workflow.service import WorkflowError, WorkflowService
+from app.errors import AlarmError, WorkflowError
+from app.workflow.service import WorkflowService
+from app.workflow.session import MeasureSession
 
 TEXT_INACTIVE = "You are compensating in an inactive WO!"
 TEXT_REALIGN = "The new WCS needs a new alignment!"
@@ -40,7 +41,7 @@ TEXT_ACTIVATED = "{wo} activated: it is the WO of the next measurement"
 TEXT_REALIGNED = "Probe re-aligned: tool axis parallel to {axis} of {wo} (head {angles})"
 HELP_RETRACT = ("Retract along the tool axis to the limit before swivelling (manual toggle field 3: "
                 "\u7a7a\u8fd0\u884c, dry run / traverse-free motion)")
-STATE_CHAIN_WO = "jm_i6"          # _JM_I[6]: WO of the next measurement (chain measuring, §6.1)
+STATE_CHAIN_WO = "jm_i6"          # _JM_I[6]: WO of the next measurement (chain measuring, jog-measuring §6.1)
 AXES = ("X", "Y", "Z")
 
 
@@ -52,7 +53,7 @@ class Choices:
     position_rotary: bool = True
 
 
-def _support_of(workflow: WorkflowService, session_id: str) -> tuple[object, dict]:
+def _support_of(workflow: WorkflowService, session_id: str) -> tuple[MeasureSession, dict]:
     session = workflow.get(session_id)
     last = session.last or {}
     support = last.get("setup_support")
@@ -74,7 +75,7 @@ def codes_of(support: dict) -> set[str]:
 
 
 def toggles(support: dict, swivel: bool) -> list[dict]:
-    """The toggle fields of the screen (spec §6.2 [I] table), all preset to Yes."""
+    """The toggle fields of the screen (jog-measuring §6.2 [I] table), all preset to Yes."""
     codes = codes_of(support)
     out = [{"name": "activate", "label": "Activate compensated WO", "value": True,
             "text": TEXT_INACTIVE if "inactive_wo" in codes else ""}]
@@ -92,7 +93,7 @@ def toggles(support: dict, swivel: bool) -> list[dict]:
 
 
 def top_line(support: dict, choices: Choices, swivel: bool) -> str:
-    """The screen's top text line follows the answers (spec §6.2 example 2)."""
+    """The screen's top text line follows the answers (jog-measuring §6.2 example 2)."""
     codes = codes_of(support)
     if "realign" in codes and choices.realign and swivel:
         return TEXT_REALIGN
@@ -134,7 +135,7 @@ def screen_model(workflow: WorkflowService, machine, session_id: str) -> dict:
 
 
 def carry_out(workflow: WorkflowService, machine, session_id: str, choices: Choices, db=None) -> dict:
-    """NC Start on the activation screen: carry out what the toggles say (spec §6.2)."""
+    """NC Start on the activation screen: carry out what the toggles say (jog-measuring §6.2)."""
     session, support = _support_of(workflow, session_id)
     if support.get("done"):
         raise WorkflowError(409, "setup_support_done", "the set-up support was already carried out or left")
@@ -225,7 +226,7 @@ def chain_wo(db) -> str | None:
 
 
 def leave(workflow: WorkflowService, session_id: str) -> dict:
-    """``<<``: leave without activating; the written correction stays (spec §6.2)."""
+    """``<<``: leave without activating; the written correction stays (jog-measuring §6.2)."""
     _session, support = _support_of(workflow, session_id)
     support["done"] = True
     support["left"] = True

@@ -150,7 +150,9 @@ def test_tool_probe_records(client):
 
 def test_settings_defaults_follow_the_spec(client):
     s = client.get("/api/settings").json()
-    assert s["plane"] == "G17" and s["measuring_wo"] == "G500" and s["attempts"] == 1
+    # _JM_I[4]: the GUD6 definition line SET(0,1,1,17,100,...) gives 100 = keep the active WO; the
+    # spec (§11 Q1) chose the element table's 0 (G500), the seed's code line wins (issue 17 note)
+    assert s["plane"] == "G17" and s["measuring_wo"] == "active" and s["attempts"] == 1
     assert (s["measuring_feed"], s["fast_feed"], s["position_feed"], s["measuring_path"]) == (300, 900, 2000, 50)
     assert (s["mt_dz"], s["mt_dir"], s["mt_ax"], s["d_l"], s["d_r"]) == (2, -1, 133, 2, 1)
 

@@ -26,7 +26,9 @@ def op(client):
 
 
 def snapshot(op: Operator) -> tuple:
-    return op.ok(op.c.get("/api/offsets")), op.ok(op.c.get("/api/log"))
+    """Offsets and the log of measurements (a failed attempt is logged too, status "alarm ...")."""
+    log = [e for e in op.ok(op.c.get("/api/log")) if not str(e["status"]).startswith("alarm")]
+    return op.ok(op.c.get("/api/offsets")), log
 
 
 def error_of(response, status: int, code: str | None = None, field: str | None = None) -> dict:
@@ -101,7 +103,7 @@ def test_unknown_session_and_point(op):
         error_of(getattr(op.c, method)(url), 404, "no_session")
     sid = op.create("hole.2", {"diameter": HOLE_D})["id"]
     error_of(op.c.post(f"/api/measure/{sid}/start", json={"point": 3}), 404, "no_point", "point")
-    error_of(op.c.post(f"/api/measure/{sid}/start", json={"point": 9}), 422, field="point")
+    error_of(op.c.post(f"/api/measure/{sid}/start", json={"point": 13}), 422, field="point")   # beyond P12
     error_of(op.c.post(f"/api/measure/{sid}/start", json={"point": "two"}), 422, field="point")
     error_of(op.c.post(f"/api/measure/{sid}/points/3/invalidate"), 404, "no_point", "point")
     error_of(op.c.post(f"/api/measure/{sid}/calculate"), 409, "points_missing")
@@ -150,6 +152,9 @@ def test_61301_nothing_touched(op):
     machine = op.ok(op.c.get("/api/machine"))
     assert [a["code"] for a in machine["alarms"]] == [61301]
     assert snapshot(op) == before
+    failed = op.ok(op.c.get("/api/log"))[0]                             # the failed attempt, logged
+    assert failed["status"] == "alarm 61301" and failed["target"] == "G54" and failed["correction"] is None
+    assert failed["result"]["alarm"]["point"] == 1
     error_of(op.c.post(f"/api/measure/{sid}/start"), 409, "alarm")      # pending until Reset
     op.ok(op.c.post("/api/machine/reset"))
     assert op.ok(op.c.get("/api/machine"))["alarms"] == []

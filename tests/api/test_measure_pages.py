@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import io
+from datetime import UTC, datetime, timedelta
 
 import pytest
 from hmi_testdata import BLOCK_TOP_Z, PROBE_LENGTH, TEST_SCENARIO
@@ -44,14 +45,15 @@ def test_target_is_preset_to_the_active_wo(client):
     text = client.get("/measure/workpiece/edge/set").text
     assert '<option value="G55" selected>' in text
     client.post("/api/machine/activate", json={"offset": "G500"})
-    assert '<option value="measure_only" selected>' in client.get("/measure/workpiece/edge/set").text
+    # under G500 nothing could be corrected: G54 is proposed, "Measure only" one choice away
+    assert '<option value="G54" selected>' in client.get("/measure/workpiece/edge/set").text
 
 
 def test_field_check_shows_the_error_next_to_the_field(client):
     answer = client.post("/measure/task/hole.1/check/diameter", data={"diameter": "-3"}, headers=HTMX)
     assert answer.status_code == 200
     assert answer.text.startswith('<span id="err-diameter" class="field-error"')
-    assert "Approx. diameter must be &gt; 0" in answer.text
+    assert "Approx. diameter: enter a value greater than 0" in answer.text      # the operator's words (issue 17)
     ok = client.post("/measure/task/hole.1/check/diameter", data={"diameter": "20"}, headers=HTMX)
     assert '<span id="err-diameter" class="field-error" role="alert"></span>' in ok.text
 
@@ -62,7 +64,7 @@ def test_nc_start_with_bad_input_keeps_the_text_and_changes_nothing(client):
     answer = client.post("/measure/task/spigot.1/start", data={"target": "G54", "diameter": "abc", "infeed": "5"},
                          headers=HTMX)
     assert answer.status_code == 200
-    assert 'value="abc"' in answer.text and "must be a number" in answer.text
+    assert 'value="abc"' in answer.text and "Approx. diameter: enter a number" in answer.text   # operator's words
     assert client.get("/api/offsets/G54").json() == before
     assert client.get("/api/machine").json()["mcs"] == position
     assert client.get("/api/log").json() == []
@@ -122,3 +124,29 @@ def test_horizontal_softkey_log(client):
 
 def test_log_detail_of_an_impossible_id_is_not_found(client):
     assert client.get("/log/99999999999999999999999").status_code == 404
+
+
+def test_the_csv_export_has_every_log_field_a_bom_and_the_local_time(client):
+    """issue [operator-ux] item 11: every log field, the byte-order mark for spreadsheets, local
+    time with its offset (the stored time is UTC)."""
+    from db.repository import LOG_FIELDS
+
+    with client.app.state.services.db.unit() as unit:
+        unit.add_log({"task": "edge.set", "target": "G54", "status": "ok", "measuring_wo": "G54",
+                      "params": {"axis": "X"}, "result": {"position": 1.5}, "warnings": ["Feed override 80 %"],
+                      "probe": {"number": 1}, "program": "MDA", "block": "N10 CYCLE978"})
+    text = client.get("/log/export.csv", params={"bom": "true", "delimiter": ";", "tz": "Asia/Shanghai"}).text
+    assert text.startswith("\ufeff")
+    rows = list(csv.reader(io.StringIO(text[1:]), delimiter=";"))
+    header, row = rows[0], dict(zip(rows[0], rows[1], strict=True))
+    for field in LOG_FIELDS:                        # every stored field has a column
+        assert field in header or f"{field}_json" in header, field
+    assert row["measuring_wo"] == "G54" and row["warnings"] == "Feed override 80 %"
+    assert row["program"] == "MDA" and row["block"] == "N10 CYCLE978" and row["probe"] == "probe 1"
+    utc = datetime.fromisoformat(row["time"]).replace(tzinfo=UTC)
+    local = datetime.fromisoformat(row["local_time"])
+    assert local.utcoffset() == timedelta(hours=8) and abs((local - utc).total_seconds()) < 1
+    refused = client.get("/log/export.csv", params={"tz": "Mars/Olympus"})
+    assert refused.status_code == 422 and refused.json()["error"]["field"] == "tz"
+    plain = client.get("/log/export.csv").text
+    assert not plain.startswith("\ufeff") and plain.startswith("id,time,task,target")

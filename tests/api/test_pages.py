@@ -57,19 +57,29 @@ def test_partials(client):
     assert client.get("/ui/header", headers=HTMX).text.lstrip().startswith('<div id="header-status"')
 
 
+def tab(axis: str = "X", increment: str = "1000") -> dict:
+    """The headers a browser tab sends with its own panel selection (static/hmi.js)."""
+    return {**HTMX, "X-Panel-Axis": axis, "X-Panel-Increment": increment}
+
+
 def test_panel_jog_with_inc_1000_moves_one_millimetre(client):
-    client.post("/ui/panel/axis", data={"axis": "Y"}, headers=HTMX)
-    client.post("/ui/panel/increment", data={"increment": "1000"}, headers=HTMX)
-    client.post("/ui/jog", data={"direction": "+"}, headers=HTMX)
+    mcp = client.post("/ui/panel/axis", data={"axis": "Y"}, headers=tab()).text
+    assert 'data-axis="Y"' in mcp
+    client.post("/ui/jog", data={"direction": "+"}, headers=tab("Y", "1000"))
     assert client.get("/api/machine").json()["mcs"]["Y"] == pytest.approx(101.0)
-    client.post("/ui/panel/increment", data={"increment": "10"}, headers=HTMX)
-    client.post("/ui/jog", data={"direction": "-"}, headers=HTMX)
+    client.post("/ui/jog", data={"direction": "-"}, headers=tab("Y", "10"))
     assert client.get("/api/machine").json()["mcs"]["Y"] == pytest.approx(100.99)
 
 
+def test_a_jog_moves_the_axis_its_tab_names_not_another_tabs(client):
+    client.post("/ui/panel/axis", data={"axis": "Z"}, headers=tab("Z"))          # tab B picks Z
+    client.post("/ui/jog", data={"direction": "+", "axis": "X"}, headers=tab("X"))  # tab A: X +
+    mcs = client.get("/api/machine").json()["mcs"]
+    assert mcs["X"] == pytest.approx(101.0) and mcs["Z"] == pytest.approx(0.0, abs=1e-9)
+
+
 def test_panel_jog_error_goes_to_the_message_line(client):
-    client.post("/ui/panel/increment", data={"increment": "cont"}, headers=HTMX)
-    text = client.post("/ui/jog", data={"direction": "+"}, headers=HTMX).text
+    text = client.post("/ui/jog", data={"direction": "+"}, headers=tab("X", "cont")).text
     assert 'id="message"' in text and "increment" in text
 
 

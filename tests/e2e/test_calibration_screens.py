@@ -68,7 +68,7 @@ def test_probe_data_screen_validates_and_saves(page, api):
     page.locator("#wp-trigger\\.X\\+").fill("abc")
     page.locator("#wp-trigger\\.X-").fill("-1.9")
     page.get_by_role("button", name=re.compile("Save")).click()
-    expect(page.locator('[data-field="trigger.X+"] .field-error')).to_contain_text("not a number")
+    expect(page.locator('[data-field="trigger.X+"] .field-error')).to_contain_text("enter a number", ignore_case=True)
     expect(page.locator('[data-field="trigger.X-"] .field-error')).to_contain_text("positive")
     after = api.get("/api/probes/2")                                   # nothing stored
     assert (after.status_code, after.json()) == (before.status_code, before.json())

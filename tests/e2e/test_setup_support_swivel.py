@@ -69,9 +69,21 @@ def test_example2_orient_plane_with_swivel(tab, http):
     # the top line follows the answers (spec §6.2 example 2)
     tab.locator('[data-toggle="realign"] select').select_option("no")
     expect(tab.locator("#ss-top-line")).to_have_text("You are compensating in an inactive WO!")
+    held = []                       # the first answer is late: the second choice is made meanwhile
+    tab.route("**/toggle", lambda route: held.append(route))
     tab.locator('[data-toggle="retract"] select').select_option("no")
+    for _ in range(50):
+        if held:
+            break
+        tab.wait_for_timeout(100)
     tab.locator('[data-toggle="realign"] select').select_option("yes")
+    tab.wait_for_timeout(300)
+    for route in list(held):
+        route.continue_()
+        tab.wait_for_timeout(300)
+    tab.unroute("**/toggle")
     expect(tab.locator("#ss-top-line")).to_have_text("The new WCS needs a new alignment!")
+    expect(tab.locator('[data-toggle="realign"] select')).to_have_value("yes")
     tab.locator('[data-toggle="retract"] select').select_option("yes")
     expect(tab.locator("#ss-dialog")).to_have_text("Press NC Start to activate!")
     tab.screenshot(path="/tmp/setup_support_swivel.png", full_page=True)

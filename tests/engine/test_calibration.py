@@ -16,10 +16,10 @@ from hypothesis import strategies as st
 
 from engine.calibration import calibrate_length, calibrate_length_point, calibrate_radius
 from engine.compensation import make_touch, skew_in_wcs
-from engine.evaluate import evaluate
 from engine.frames import Frame, rot_z
 from engine.plan_base import RingCalibrationPoint, RingPass
 from engine.planes import PLANES
+from engine.tasks import evaluate
 from engine.types import CirclePoint, EdgePoint, MeasuringError, ProbeRecord, Touch
 
 G17 = PLANES["G17"]

@@ -8,13 +8,15 @@ the geometry (lines, circles, planes), independently of the engine's formulas.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from engine.evaluate import evaluate
 from engine.planes import PLANES, Plane
+from engine.tasks import evaluate
 from engine.types import CirclePoint, EdgePoint, MeasuringError, ProbeRecord, RectPoint, Touch
 
 SETTINGS = settings(max_examples=40, deadline=None)
@@ -199,7 +201,12 @@ def test_corner_any(plane, k, phi1, delta, pos, kind, d1, dd, d3, dd3, swap):
     assert got[plane.first] == pytest.approx(k[0], abs=TOL)
     assert got[plane.second] == pytest.approx(k[1], abs=TOL)
     assert res.values["angle"] == pytest.approx(phi1, abs=TOL)
-    assert res.values["corner_angle"] == pytest.approx(90.0 - abs(delta), abs=1e-8)
+    # the corner's own angle: between the edges as they leave K (−sa·u1 and −so·u2, corner_points)
+    sa, so = CORNER_SIGNS[pos]
+    u1, u2 = unit2(phi1), unit2(phi1 + 90.0 + delta)
+    u2 = -u2 if u2[1] < 0 else u2
+    expected = math.degrees(math.acos(max(-1.0, min(1.0, sa * so * float(u1 @ u2)))))
+    assert res.values["corner_angle"] == pytest.approx(expected, abs=1e-8)
 
 
 def test_corner_errors():

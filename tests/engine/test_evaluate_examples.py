@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from engine.compensation import make_touch
-from engine.evaluate import evaluate
 from engine.planes import PLANES
+from engine.tasks import evaluate
 from engine.types import CirclePoint, EdgePoint, ProbeRecord, Touch
 
 G17 = PLANES["G17"]

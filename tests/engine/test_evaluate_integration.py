@@ -15,10 +15,10 @@ from test_plan_world import Bore, HalfSpace, Spigot, World, drive
 
 from engine.calibration import calibrate_radius
 from engine.compensation import skew_in_wcs
-from engine.evaluate import evaluate
 from engine.frames import Frame
 from engine.plan import PlanContext, point_program, validate_params
 from engine.planes import PLANES
+from engine.tasks import evaluate
 from engine.types import ProbeRecord
 
 G17 = PLANES["G17"]

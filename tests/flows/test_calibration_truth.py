@@ -10,6 +10,12 @@ Known limit (engine/calibration.py docstring): a ring of unknown centre cannot t
 centre from a difference δ(+) − δ(−) on one axis, so calibrated positions probed along +j are off
 by k_j = (δ(+j) − δ(−j))/2 (the example probe: −0.5 µm in X, −1.5 µm in Y). The set-up test
 states that part explicitly; with per-axis symmetric pre-travel the set-up reaches the noise.
+
+These figures (skew = e, ring centre = M + k, a set-up off by k) are those of the wave-1
+simulator, whose pre-travel is fixed to the machine axes: the scenarios that assert them say
+``"pretravel_frame": "machine"`` (WAVE1). With the default probe-frame pre-travel (design.md
+§9.8) the lobing turns with SPOS, the 0°/180° calibration observes k and the stored skew is
+e − k instead (engine/calibration.py).
 """
 
 from __future__ import annotations
@@ -20,6 +26,7 @@ from flowkit import Flow, cal_scenario, make_client, ok, rpy
 
 FEED = 300.0                     # E_MESS_FM default, mm/min
 NOISE = 0.0003
+WAVE1 = {"probe__pretravel_frame": "machine"}      # the wave-1 pre-travel model these figures follow
 
 
 def latency_path(sc: dict, override: float = 100.0) -> float:
@@ -34,7 +41,7 @@ def k_shift(sc: dict) -> np.ndarray:
 
 @pytest.fixture
 def flow(tmp_path):
-    sc = cal_scenario()
+    sc = cal_scenario(**WAVE1)
     with make_client(tmp_path, sc) as client:
         yield Flow(client, sc)
 
@@ -121,7 +128,7 @@ def test_corner_and_z_setup_reaches_the_noise_after_calibration(tmp_path, rot_z)
     (0.8 µm without k) / 2.2 µrad; uncalibrated 224 µm. Calibrated = noise + k (−0.5, −1.5 µm):
     the oblique edge of the 12.5° part needs no allowance of its own.
     """
-    sc = cal_scenario(workpiece__pose={"trans": [250.0, 150.0, -120.0], "rot": [0.0, 0.0, rot_z]})
+    sc = cal_scenario(workpiece__pose={"trans": [250.0, 150.0, -120.0], "rot": [0.0, 0.0, rot_z]}, **WAVE1)
     dt_cal, angle_cal, _ = _setup_errors(tmp_path / "cal", sc, calibrate=True)
     dt_raw, _angle_raw, _ = _setup_errors(tmp_path / "raw", sc, calibrate=False)
     # without calibration: the wrong nominal length, the eccentricity and pre-travel + latency

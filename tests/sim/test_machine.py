@@ -8,16 +8,13 @@ import pytest
 from sim_helpers import plane_contact, rotation, scenario
 
 from app.machine.protocol import (
-    ALARM_LIMIT,
-    ALARM_PROBE_BROKEN,
-    ALARM_PROBE_COLLISION,
-    ALARM_RESET,
     ActiveFrame,
     Machine,
     MachineAlarm,
     MachineBusy,
 )
 from app.machine.sim import SimulatedMachine
+from engine import alarms
 
 L = 100.0
 R_BALL = 2.0
@@ -49,10 +46,12 @@ def test_implements_protocol():
 
 
 def test_pretravel_and_eccentricity_shift_the_latched_position():
+    """The wave-1 model (``pretravel_frame`` "machine"): the lobing stays with the machine axes
+    while the eccentricity turns with SPOS (the probe-frame default: tests/sim/test_probe_frame.py)."""
     pre = {"X+": 0.004, "X-": 0.005, "Y+": 0.003, "Y-": 0.006, "Z-": 0.002}
     ecc = np.array([0.01, -0.006])
     sc = scenario(probe={"t": 9, "ball_diameter": 4.0, "length": L, "max_deflection": 5.0,
-                         "pretravel": pre, "eccentricity": list(ecc)})
+                         "pretravel": pre, "eccentricity": list(ecc), "pretravel_frame": "machine"})
     p_face, n = _front_face(sc)
     d = -n
     for spos in (0.0, 90.0, 180.0):
@@ -142,13 +141,13 @@ def test_collision_during_goto_stops_short_with_61302():
     start = _xyz(m.status().mcs)
     target = start - 60.0 * n
     result = m.goto(dict(zip(XYZ, target, strict=True)), feed=1000.0)
-    assert not result.completed and result.alarm.code == ALARM_PROBE_COLLISION
+    assert not result.completed and result.alarm.code == alarms.PROBE_COLLISION.number
     # braking behind the switch (measuring-math §1.3): v = 1000 mm/min, t = 0, a = 1 m/s², Kv = 1
     v = 1000.0 / 60000.0                                      # m/s
     s_b = 1000.0 * v**2 / (2 * 1.0) + 1.0 / 1.0               # 0.1389 mm + following error 1 mm
     expected = start + (30.0 + s_b) * (-n)
     assert _xyz(result.mcs) == pytest.approx(expected, abs=1e-9)
-    assert [a.code for a in m.status().alarms] == [ALARM_PROBE_COLLISION]
+    assert [a.code for a in m.status().alarms] == [alarms.PROBE_COLLISION.number]
     m.reset()
     assert m.status().alarms == ()
     # the deflected probe can be moved away again
@@ -159,16 +158,16 @@ def test_rapid_into_the_part_breaks_the_probe_until_tool_change():
     m, _, n = _machine_in_front(scenario(), gap=30.0)
     start = _xyz(m.status().mcs)
     result = m.goto(dict(zip(XYZ, start - 60.0 * n, strict=True)))     # rapid
-    assert result.alarm.code == ALARM_PROBE_COLLISION
-    alarms = m.status().alarms
-    assert [(a.code, a.resettable) for a in alarms] == [(ALARM_PROBE_COLLISION, True),   # collision,
-                                                        (ALARM_PROBE_BROKEN, False)]     # broken stylus
+    assert result.alarm.code == alarms.PROBE_COLLISION.number
+    pending = m.status().alarms
+    assert [(a.code, a.resettable) for a in pending] == [(alarms.PROBE_COLLISION.number, True),   # collision,
+                                                        (alarms.PROBE_BROKEN.number, False)]     # broken stylus
     m.reset()
     remaining = m.status().alarms
-    assert len(remaining) == 1 and remaining[0].code == ALARM_PROBE_BROKEN and not remaining[0].resettable
+    assert len(remaining) == 1 and remaining[0].code == alarms.PROBE_BROKEN.number and not remaining[0].resettable
     with pytest.raises(MachineAlarm) as err:
         m.jog("Z", 10.0)
-    assert err.value.alarm.code == ALARM_PROBE_BROKEN and not err.value.alarm.resettable
+    assert err.value.alarm.code == alarms.PROBE_BROKEN.number and not err.value.alarm.resettable
     m.change_tool(9, 100.0)
     assert m.status().alarms == ()
     assert m.goto(dict(zip(XYZ, start, strict=True))).completed
@@ -178,7 +177,7 @@ def test_probe_overtravel_beyond_max_deflection_breaks():
     m, _, n = _machine_in_front(scenario())      # max_deflection 5 mm; 6000 mm/min brakes > 6 mm
     with pytest.raises(MachineAlarm) as err:
         m.probe(-n, 20.0, 6000.0)
-    assert err.value.alarm.code == ALARM_PROBE_BROKEN and not err.value.alarm.resettable   # 61302 is also
+    assert err.value.alarm.code == alarms.PROBE_BROKEN.number and not err.value.alarm.resettable   # 61302 is also
     m.reset()                                                                          # the collision
     with pytest.raises(MachineAlarm) as err:
         m.probe(n, 20.0, 300.0)
@@ -196,7 +195,7 @@ def test_manual_braking_example_1_3_a_on_the_machine(max_deflection, breaks):
     if breaks:
         with pytest.raises(MachineAlarm) as err:
             m.probe(-n, 30.0, 6000.0)
-        assert err.value.alarm.code == ALARM_PROBE_BROKEN and not err.value.alarm.resettable
+        assert err.value.alarm.code == alarms.PROBE_BROKEN.number and not err.value.alarm.resettable
         end = _xyz(m.status().mcs)
     else:
         r = m.probe(-n, 30.0, 6000.0)
@@ -210,13 +209,13 @@ def test_limits_refuse_before_moving():
     before = m.status().mcs
     with pytest.raises(MachineAlarm) as err:
         m.goto({"X": 5000.0})
-    assert err.value.alarm.code == ALARM_LIMIT
+    assert err.value.alarm.code == alarms.SOFTWARE_LIMIT.number
     with pytest.raises(MachineAlarm):
         m.probe([0, 0, 1], 100.0, 300.0)           # Z 50 -> 150 > 100
     with pytest.raises(MachineAlarm):
         m.jog("Y", -1000.0)
     assert m.status().mcs == before
-    assert ALARM_LIMIT in {a.code for a in m.status().alarms}
+    assert alarms.SOFTWARE_LIMIT.number in {a.code for a in m.status().alarms}
 
 
 def test_time_scale_zero_is_instant():
@@ -241,7 +240,7 @@ def test_reset_aborts_a_timed_move_and_status_interpolates():
     m.reset()
     worker.join(2.0)
     r = results["r"]
-    assert not r.completed and r.alarm.code == ALARM_RESET
+    assert not r.completed and r.alarm.code == alarms.RESET_ABORT.number
     assert 0.5 < r.mcs["X"] < 20.0 and not m.status().busy
     assert m.status().mcs["X"] == pytest.approx(r.mcs["X"])
 
@@ -260,7 +259,7 @@ def test_continuous_jog_stop_and_limit():
     m2.jog_continuous("Y", -1)
     m2.stop()
     assert m2.status().mcs["Y"] == pytest.approx(-100.0)
-    assert ALARM_LIMIT in {a.code for a in m2.status().alarms}
+    assert alarms.SOFTWARE_LIMIT.number in {a.code for a in m2.status().alarms}
 
 
 def test_wcs_display_uses_frame_and_offset_length():
@@ -300,7 +299,7 @@ def test_cutter_touching_the_workpiece_is_a_collision():
     above = rot @ np.array([100.0, 90.0, 10.0]) + np.asarray(sc.workpiece.pose.trans)
     m.goto({"X": above[0], "Y": above[1], "Z": above[2] + 85.0})
     result = m.goto({"Z": above[2] + 85.0 - 30.0}, feed=500.0)
-    assert not result.completed and result.alarm.code == ALARM_PROBE_COLLISION
+    assert not result.completed and result.alarm.code == alarms.PROBE_COLLISION.number
     assert result.mcs["Z"] == pytest.approx(above[2] + 85.0 - 10.0, abs=1e-9)   # tip on the top face
 
 

@@ -1,0 +1,301 @@
+"""Users, API tokens, sign-in sessions and the simulated keyswitch (design.md §9.2).
+
+- Passwords are hashed with argon2id by pwdlib (a maintained library made for it); the hash is
+  all the database holds.
+- API tokens and session cookies are 256-bit random secrets; the database holds their SHA-256 (a
+  random secret of that size needs no slow hash), so a stolen database signs nobody in.
+- Sign-in is on as soon as one user exists (the check is cached for a second, so a user added by
+  ``python -m app user add`` in another process takes effect at once, near enough).
+- The keyswitch is machine state (``machine_state`` "keyswitch", position 0..3, default 0); the
+  operator panel's session has the keyswitch's level, read on every request.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import re
+import secrets
+import threading
+import time
+from datetime import UTC, datetime, timedelta
+from http.cookies import SimpleCookie
+
+from pwdlib import PasswordHash
+
+from db import Database
+
+from .identity import ANONYMOUS, INVALID, NOBODY, PANEL, TOKEN, TRAINER, USER, Identity
+from .levels import KEYSWITCH_POSITIONS, PASSWORD_LEVELS, TOKEN_LEVELS, TRAINER_LEVEL, keyswitch_level
+
+SESSION_COOKIE = "hmi_session"
+CSRF_COOKIE = "csrftoken"
+NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.@-]{0,63}$")
+MIN_PASSWORD = 4
+TOKEN_PREFIX = "hmi_"
+STATE_KEYSWITCH = "keyswitch"
+STATE_CSRF_SECRET = "access.csrf_secret"
+MAX_FAILURES, LOCKOUT_S = 5, 30.0
+USERS_CACHE_S = 1.0
+
+
+class AccessError(ValueError):
+    """Bad input to an administration call (name, level, password)."""
+
+
+class SignInRefused(Exception):
+    def __init__(self, message: str, status: int = 401, code: str = "sign_in_failed"):
+        super().__init__(message)
+        self.message, self.status, self.code = message, status, code
+
+
+def digest(secret: str) -> str:
+    return hashlib.sha256(secret.encode()).hexdigest()
+
+
+def _now() -> datetime:
+    return datetime.now(UTC)
+
+
+def check_name(name: str, what: str = "name") -> str:
+    if not isinstance(name, str) or not NAME.match(name):
+        raise AccessError(f"{what}: 1-64 letters, digits or _.@- (starting with a letter or digit)")
+    return name
+
+
+def check_level(level, allowed: tuple[int, ...], what: str) -> int:
+    if isinstance(level, bool) or not isinstance(level, int) or level not in allowed:
+        raise AccessError(f"level: a {what} has level {allowed[0]}..{allowed[-1]}, got {level!r}")
+    return level
+
+
+def check_password(password) -> str:
+    if not isinstance(password, str) or len(password) < MIN_PASSWORD:
+        raise AccessError(f"password: at least {MIN_PASSWORD} characters")
+    return password
+
+
+class AccessService:
+    def __init__(self, db: Database, session_hours: float = 8.0):
+        self._db = db
+        self._session_hours = session_hours
+        self._hasher = PasswordHash.recommended()
+        self._dummy_hash: str | None = None
+        self._lock = threading.Lock()
+        self._users_cache: tuple[float, bool] | None = None
+        self._failures: dict[str, tuple[int, float]] = {}
+
+    # --- mode -------------------------------------------------------------------------------
+    def signin_on(self) -> bool:
+        """At least one user exists (else: the stand-alone trainer)."""
+        cached = self._users_cache
+        now = time.monotonic()
+        if cached is not None and now - cached[0] < USERS_CACHE_S:
+            return cached[1]
+        with self._db.unit(readonly=True) as unit:
+            exists = unit.users_exist()
+        self._users_cache = (now, exists)
+        return exists
+
+    def _forget_users(self) -> None:
+        self._users_cache = None
+
+    # --- users ------------------------------------------------------------------------------
+    def add_user(self, name: str, level: int, password: str) -> dict:
+        check_name(name, "user")
+        check_level(level, PASSWORD_LEVELS, "user (password)")
+        password_hash = self._hasher.hash(check_password(password))
+        with self._db.unit() as unit:
+            try:
+                user = unit.add_user(name, level, password_hash)
+            except ValueError as exc:
+                raise AccessError(str(exc)) from None
+            unit.add_audit("user", name, None, user, "users")
+        self._forget_users()
+        return user
+
+    def set_password(self, name: str, password: str) -> None:
+        password_hash = self._hasher.hash(check_password(password))
+        with self._db.unit() as unit:
+            try:
+                unit.set_password_hash(name, password_hash)
+            except KeyError:
+                raise AccessError(f"no user {name!r}") from None
+            unit.add_audit("user", name, None, {"name": name, "password": "changed"}, "users")
+
+    def delete_user(self, name: str) -> dict:
+        with self._db.unit() as unit:
+            try:
+                user = unit.delete_user(name)
+            except KeyError:
+                raise AccessError(f"no user {name!r}") from None
+            unit.add_audit("user", name, user, None, "users")
+        self._forget_users()
+        return user
+
+    def list_users(self) -> list[dict]:
+        with self._db.unit(readonly=True) as unit:
+            return unit.list_users()
+
+    # --- tokens -----------------------------------------------------------------------------
+    def add_token(self, name: str, level: int) -> tuple[str, dict]:
+        """(the secret, shown once; the stored record without it)."""
+        check_name(name, "token")
+        check_level(level, TOKEN_LEVELS, "token")
+        secret = TOKEN_PREFIX + secrets.token_urlsafe(32)
+        with self._db.unit() as unit:
+            try:
+                record = unit.add_token(name, level, digest(secret))
+            except ValueError as exc:
+                raise AccessError(str(exc)) from None
+            unit.add_audit("token", name, None, record, "users")
+        return secret, record
+
+    def delete_token(self, name: str) -> dict:
+        with self._db.unit() as unit:
+            try:
+                record = unit.delete_token(name)
+            except KeyError:
+                raise AccessError(f"no token {name!r}") from None
+            unit.add_audit("token", name, record, None, "users")
+        return record
+
+    def list_tokens(self) -> list[dict]:
+        with self._db.unit(readonly=True) as unit:
+            return unit.list_tokens()
+
+    # --- keyswitch --------------------------------------------------------------------------
+    def keyswitch(self) -> int:
+        with self._db.unit(readonly=True) as unit:
+            position = unit.get_state(STATE_KEYSWITCH, 0)
+        return position if position in KEYSWITCH_POSITIONS else 0
+
+    def set_keyswitch(self, position: int, source: str = "api") -> dict:
+        if isinstance(position, bool) or position not in KEYSWITCH_POSITIONS:
+            raise AccessError("position: the keyswitch has positions 0..3")
+        with self._db.unit() as unit:
+            before = unit.get_state(STATE_KEYSWITCH, 0)
+            unit.set_state(STATE_KEYSWITCH, position)
+            unit.add_audit("keyswitch", "keyswitch", {"position": before}, {"position": position}, source)
+        return {"position": position, "level": keyswitch_level(position)}
+
+    # --- sessions ---------------------------------------------------------------------------
+    def sign_in(self, name: str, password: str) -> tuple[str, Identity]:
+        """(cookie secret, identity); SignInRefused for a wrong name or password (one message
+        for both) and after repeated failures for a while."""
+        identity = self.verify_password(name, password)
+        return self._open_session(name, identity)
+
+    def verify_password(self, name: str, password: str) -> Identity:
+        """The user's identity when the password is right (no session: the OPC UA endpoint signs
+        in per connection); SignInRefused as ``sign_in``, sharing its lockout."""
+        if not isinstance(name, str) or not isinstance(password, str):
+            raise SignInRefused("user and password are required", 422, "validation")
+        self._check_lockout(name)
+        with self._db.unit(readonly=True) as unit:
+            user = unit.get_user(name, with_hash=True)
+        if user is None:
+            self._hasher.verify(password, self._dummy())       # the same time as a wrong password
+        if user is None or not self._hasher.verify(password, user["password_hash"]):
+            self._fail(name)
+            raise SignInRefused("wrong user name or password")
+        self._failures.pop(name, None)
+        return Identity(USER, name, user["level"])
+
+    def user_identity(self, name: str) -> Identity | None:
+        """The user's identity with the level stored now; None when the user is gone."""
+        with self._db.unit(readonly=True) as unit:
+            user = unit.get_user(name)
+        return None if user is None else Identity(USER, name, user["level"])
+
+    def sign_in_panel(self) -> tuple[str, Identity]:
+        """The operator panel (the browser on the machine's own computer): no password, the
+        keyswitch's level. The caller checks that the request comes from this computer."""
+        return self._open_session(None, Identity(PANEL, "panel", keyswitch_level(self.keyswitch())))
+
+    def _open_session(self, user: str | None, identity: Identity) -> tuple[str, Identity]:
+        secret = secrets.token_urlsafe(32)
+        expires = (_now() + timedelta(hours=self._session_hours)).isoformat(timespec="microseconds")
+        with self._db.unit() as unit:
+            unit.add_session(digest(secret), user, expires)
+        return secret, Identity(identity.kind, identity.name, identity.level, expires)
+
+    def sign_out(self, secret: str | None) -> None:
+        if secret:
+            with self._db.unit() as unit:
+                unit.delete_session(digest(secret))
+
+    @property
+    def session_seconds(self) -> int:
+        return int(self._session_hours * 3600)
+
+    def _dummy(self) -> str:
+        if self._dummy_hash is None:
+            self._dummy_hash = self._hasher.hash(secrets.token_urlsafe(16))
+        return self._dummy_hash
+
+    def _check_lockout(self, name: str) -> None:
+        failures, until = self._failures.get(name, (0, 0.0))
+        if failures >= MAX_FAILURES and time.monotonic() < until:
+            raise SignInRefused(f"too many failed sign-ins for {name!r}: wait {LOCKOUT_S:.0f} s", 429,
+                                "too_many_attempts")
+
+    def _fail(self, name: str) -> None:
+        with self._lock:
+            failures, _until = self._failures.get(name, (0, 0.0))
+            self._failures[name] = (failures + 1, time.monotonic() + LOCKOUT_S)
+
+    # --- who is this request ----------------------------------------------------------------
+    def resolve(self, authorization: str | None, cookie_header: str | None) -> Identity:
+        """Bearer token first, then the session cookie; without either: the trainer when no user
+        exists, else nobody. Wrong credentials are INVALID (401), never the trainer."""
+        if authorization:
+            scheme, _, bearer = authorization.partition(" ")
+            if scheme.lower() != "bearer" or not bearer.strip():
+                return Identity(INVALID, reason="Authorization must be 'Bearer <token>'")
+            with self._db.unit(readonly=True) as unit:
+                token = unit.token_by_hash(digest(bearer.strip()))
+            if token is None:
+                return Identity(INVALID, reason="unknown or revoked API token")
+            return Identity(TOKEN, token["name"], token["level"])
+        secret = session_secret(cookie_header)
+        if secret:
+            with self._db.unit(readonly=True) as unit:
+                session = unit.get_session(digest(secret))
+                position = unit.get_state(STATE_KEYSWITCH, 0) if session and session["user"] is None else 0
+            if session is not None:
+                user = session["user"]
+                if user is None:
+                    level = keyswitch_level(position if position in KEYSWITCH_POSITIONS else 0)
+                    return Identity(PANEL, "panel", level, session["expires"])
+                return Identity(USER, user["name"], user["level"], session["expires"])
+        if not self.signin_on():
+            return Identity(TRAINER, None, TRAINER_LEVEL)
+        return NOBODY
+
+    def csrf_secret(self) -> str:
+        """The CSRF tokens' signing secret, kept in the database so tokens outlive a restart."""
+        with self._db.unit(readonly=True) as unit:
+            secret = unit.get_state(STATE_CSRF_SECRET)
+        if isinstance(secret, str) and len(secret) >= 32:
+            return secret
+        with self._db.unit() as unit:
+            secret = unit.get_state(STATE_CSRF_SECRET)
+            if not (isinstance(secret, str) and len(secret) >= 32):
+                secret = secrets.token_urlsafe(48)
+                unit.set_state(STATE_CSRF_SECRET, secret)
+        return secret
+
+
+def session_secret(cookie_header: str | None) -> str | None:
+    if not cookie_header:
+        return None
+    cookies = SimpleCookie()
+    try:
+        cookies.load(cookie_header)
+    except Exception:        # a malformed Cookie header is no session
+        return None
+    morsel = cookies.get(SESSION_COOKIE)
+    return morsel.value if morsel is not None and morsel.value else None
+
+
+__all__ = ["ANONYMOUS", "CSRF_COOKIE", "SESSION_COOKIE", "AccessError", "AccessService", "SignInRefused"]

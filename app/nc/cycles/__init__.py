@@ -1,0 +1,24 @@
+"""The measuring cycles as NC calls (design.md §9.4, measuring-math §7–measuring-math §14).
+
+    cycles = measuring_cycles(host)                 # {"CYCLE977": handler, ...}
+    Interpreter(runtime, variables, cycles=cycles)
+
+Each handler reads its parameters from the variable store (SW 6.3 style: set before the call),
+runs the JOG task that measures the same feature through the JOG workflow on the environment the
+``host`` (``base.CycleHost``, implemented by app.services.nc) gives it, and writes ``_OVR``/``_OVI``.
+"""
+
+from __future__ import annotations
+
+from app.nc.cycles import calibration, sphere, workpiece
+from app.nc.cycles.base import CycleHost, NcMeasuring
+
+CYCLE_NAMES = ("CYCLE976", "CYCLE977", "CYCLE978", "CYCLE979", "CYCLE998", "CYCLE961", "CYCLE997", "CYCLE971")
+
+
+def measuring_cycles(host: CycleHost) -> dict:
+    handlers = {**workpiece.handlers(host), **sphere.handlers(host), **calibration.handlers(host)}
+    return {name: handlers[name] for name in CYCLE_NAMES}
+
+
+__all__ = ["CYCLE_NAMES", "CycleHost", "NcMeasuring", "measuring_cycles"]

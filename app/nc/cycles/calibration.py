@@ -1,0 +1,131 @@
+"""CYCLE976 (calibrate the workpiece probe, measuring-math §7) and CYCLE971 (tool probe and tool
+measuring, measuring-math §14) as NC calls on the JOG tasks probe.radius / probe.length and
+toolprobe.calibrate / tool.length / tool.diameter.
+
+CYCLE976: 4-direction bore variants (units digit 1 known or 8 unknown centre, 4th digit 0) run
+the JOG ring calibration (centre search, passes at SPOS 180° and 0°: skew, trigger values and the
+effective ball diameter are always determined); 10000 calibrates the length on a surface at
+``_SETVAL``. CYCLE971: 0 calibrates the tool probe (``_MA`` 3: length only, else all
+directions), 1 and 2 measure the length (``_MA`` 3) or the radius (``_MA`` 1/2) of the tool in
+the spindle (stationary or rotating as the JOG task decides it from the tool and probe sizes),
+``_CHBIT[3]`` 0 into the geometry, 1 into the wear; 100000 is the automatic calibration.
+"""
+
+from __future__ import annotations
+
+from app.nc.cycles.base import Call, CycleAlarm, digit, run_cycle, variant_error
+from app.workflow.tasks import TASKS
+from engine import alarms
+
+TRIGGER_SLOTS = {"-1": 8, "+1": 10, "-2": 12, "+2": 14, "-3": 16, "+3": 18}
+
+
+def _trigger_results(call: Call, new: dict, old: dict) -> None:
+    """_OVR[8..19]: trigger values actual / difference per direction (−a, +a, −o, +o, −p, +p)."""
+    plane = call.plane
+    for i, axis in enumerate(plane.axes, start=1):
+        for sign in ("-", "+"):
+            key = f"{axis}{sign}"
+            if key in new:
+                slot = TRIGGER_SLOTS[f"{sign}{i}"]
+                call.ovr[slot] = call.out(new[key])
+                call.ovr[slot + 1] = call.out(new[key] - float(old.get(key, new[key])))
+
+
+def cycle976(call: Call) -> None:
+    v = call.variant
+    env = call.measuring()
+    before = env.context()
+    if before.probe is None:
+        raise CycleAlarm(alarms.PROBE_TYPE, "the tool in the spindle is not a 3D probe (type 710): load the probe")
+    old = before.probe
+    setval = call.length("_SETVAL")
+    params: dict[str, object]                           # the task's JSON params
+    if v == 10000:
+        if call.integer("_MA") not in (0, 3):
+            raise CycleAlarm(alarms.MEASURING_AXIS, "_MVAR=10000 calibrates the length in the applicate: _MA=3")
+        task, params = "probe.length", {"setpoint": {call.plane.infeed: setval}}
+    elif digit(v, 1) in (1, 8) and v < 1_000_000 and digit(v, 2) == 0 and digit(v, 6) == 0 and digit(v, 4) == 0:
+        if not setval > 0.0:
+            raise CycleAlarm(alarms.NC_VALUE_RANGE, f"_SETVAL = {setval:g}: the ring diameter must be > 0")
+        task, params = "probe.radius", {"diameter": setval}
+    elif v == 0:
+        raise variant_error(call, "the surface calibration of one direction (_MVAR=0) is not supported; "
+                                  "10000 calibrates the length")
+    else:
+        raise variant_error(call, "supported: 10000 (length on a surface) and the 4-direction bore variants "
+                                  "(xx0x01, xx0x08; 1 or 2 directions and 'at an angle' are not supported)")
+    params["measurements"] = call.measurements()
+    answer = call.run(env, TASKS[task], params, "measure_only")
+    result = answer.get("result") or {}
+    probe = result.get("probe") or {}
+    new_trigger = {k: float(x) for k, x in (probe.get("trigger") or {}).items()}
+    _trigger_results(call, new_trigger, dict(old.trigger))
+    effective = float(probe.get("effective_diameter") or 0.0)
+    call.ovr[4] = call.out(effective)
+    call.ovr[5] = call.out(effective - float(old.effective_diameter or 0.0)) if effective else 0.0
+    skew = probe.get("skew") or {}
+    call.ovr[20] = call.out(float(skew.get("X", 0.0)))
+    call.ovr[21] = call.out(float(skew.get("Y", 0.0)))
+    centre = result.get("center")
+    if isinstance(centre, dict):
+        plane = call.plane
+        call.ovr[6] = call.out(float(centre.get(plane.first, 0.0)))
+        call.ovr[7] = call.out(float(centre.get(plane.second, 0.0)))
+    if task == "probe.length":
+        call.ovr[8] = call.out(float(result.get("length", 0.0)))
+        call.ovr[9] = call.out(float(result.get("difference", 0.0)))
+    call.ovr[27] = call.out(call.length("_TZL"))
+    call.ovr[28] = call.out(call.length("_TSA"))
+
+
+def cycle971(call: Call) -> None:
+    v = call.variant
+    ma = call.integer("_MA")
+    env = call.measuring()
+    if v in (0, 100000):
+        if ma not in (1, 2, 3, 102, 201):
+            raise CycleAlarm(alarms.MEASURING_AXIS, f"_MA = {ma}: 1, 2, 3, 102 or 201")
+        mode = "length" if ma == 3 and v == 0 else "length_diameter"
+        old = dict((env.context().extra.get("tool_probe") or {}).get("trigger") or {})
+        answer = call.run(env, TASKS["toolprobe.calibrate"], {"mode": mode}, "measure_only")
+        record = (answer.get("result") or {}).get("tool_probe") or {}
+        new = {k: float(x) for k, x in (record.get("trigger") or {}).items()}
+        _trigger_results(call, new, old)
+        call.ovr[27] = call.out(call.length("_TZL"))
+        call.ovr[28] = call.out(call.length("_TSA"))
+        return
+    if v in (10, 11, 12, 10000, 10010, 100010):
+        raise variant_error(call, "workpiece-related (_TPW) and incremental calibrations are not supported")
+    if v not in (1, 2):
+        raise variant_error(call, "CYCLE971: 0 / 100000 calibrate, 1 (stationary) / 2 (rotating) measure")
+    if ma not in (1, 2, 3, 103, 203):
+        raise CycleAlarm(alarms.MEASURING_AXIS, f"_MA = {ma}: 1/2 radius, 3/103/203 length")
+    offset_v = call.length("_ID")
+    if offset_v < 0.0:
+        raise CycleAlarm(alarms.NC_VALUE_RANGE, f"_ID = {offset_v:g}: the offset must be >= 0")
+    task = "tool.length" if ma in (3, 103, 203) else "tool.diameter"
+    compensation = "wear" if call.bit("_CHBIT", 3) else "geometry"
+    answer = call.run(env, TASKS[task], {"offset_v": offset_v, "compensation": compensation}, "measure_only")
+    result = answer.get("result") or {}
+    before = (answer.get("correction") or {}).get("before") or {}
+    tool = result.get("tool") or {}
+    wear_before = before.get("wear") or {}
+    if task == "tool.length":
+        value = float(result["length"])
+        call.ovr[8] = call.out(value)
+        call.ovr[9] = call.out(value - float(before.get("length", 0.0)) - float(wear_before.get("length", 0.0)))
+    else:
+        value = float(result["radius"])
+        call.ovr[10] = call.out(value)
+        call.ovr[11] = call.out(value - float(before.get("radius", 0.0)) - float(wear_before.get("radius", 0.0)))
+    call.ovr[27] = call.out(call.length("_TZL"))
+    call.ovr[28] = call.out(call.length("_TSA"))
+    call.ovr[29] = call.out(call.length("_TDIF"))
+    call.ovi[0] = 1
+    call.ovi[8] = int(tool.get("t") or 0)
+
+
+def handlers(host) -> dict:
+    return {"CYCLE976": lambda ctx: run_cycle(ctx, host, 976, cycle976),
+            "CYCLE971": lambda ctx: run_cycle(ctx, host, 971, cycle971)}

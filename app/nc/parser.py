@@ -1,0 +1,544 @@
+"""Parser: program text -> ``nodes.Program`` (lark LALR on ``grammar.lark``).
+
+``parse_program`` raises ``NcSyntaxError(line, column, message)`` in operator words for anything
+wrong with the text itself: the grammar, words that do not exist, words that may not stand
+together in one block (two G functions of one group, G100 with two axes, MEAS without a motion,
+...), DEF after the first instruction, jump targets that do not exist. Names of variables and
+cycles are checked later against the variable store and the cycle registry
+(``Interpreter.load``), because they depend on the control's configuration.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from importlib import resources
+
+from lark import Lark, Token, Transformer, Tree, v_args
+from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken, VisitError
+
+from engine import alarms
+
+from . import nodes as n
+from .errors import NcSyntaxError
+from .modal import (
+    AXIS_LETTERS,
+    FRAME_SUPPRESS,
+    KNOWN_M,
+    MEASURING,
+    MOTION,
+    g_group,
+)
+
+#: how a terminal is named in an error message
+_TERMINAL_WORDS = {
+    "_NL": "the end of the block", "EQUAL": "'='", "LSQB": "'['", "RSQB": "']'", "LPAR": "'('",
+    "RPAR": "')'", "COMMA": "','", "COLON": "':'", "NUMBER": "a number", "INT_NUMBER": "a number",
+    "NAME": "a name", "RPARAM": "an R parameter", "STRING": "a text in quotes", "ADDRESS": "a word",
+    "BLOCKNO": "a block number", "CMP_OP": "a comparison", "ADD_OP": "'+' or '-'",
+    "MUL_OP": "'*' or '/'",
+}
+_EXPRESSION_START = {"NUMBER", "INT_NUMBER", "NAME", "RPARAM", "STRING", "LPAR", "ADD_OP", "NOT",
+                     "TRUE", "FALSE"}
+_UNSUPPORTED_ADDRESS = {
+    "I": "circle and helix parameters (I, J, K) are not part of this control's language",
+    "J": "circle and helix parameters (I, J, K) are not part of this control's language",
+    "K": "circle and helix parameters (I, J, K) are not part of this control's language",
+    "H": "auxiliary functions H are not part of this control's language",
+    "E": "exponent notation and E words are not part of this control's language",
+}
+_STRUCTURED = {"ELSE", "ENDIF", "WHILE", "ENDWHILE", "FOR", "ENDFOR", "LOOP", "ENDLOOP", "REPEAT",
+               "UNTIL", "CASE", "RET", "PROC"}
+TYPES = {"REAL", "INT", "BOOL", "STRING"}
+
+
+@lru_cache(maxsize=1)
+def _lark() -> Lark:
+    grammar = resources.files(__package__).joinpath("grammar.lark").read_text(encoding="utf-8")
+    return Lark(grammar, parser="lalr", lexer="contextual", propagate_positions=True,
+                maybe_placeholders=True, start="start")
+
+
+def _pos(item) -> n.Pos:
+    if isinstance(item, Token):
+        assert item.line is not None and item.column is not None    # the lexer's tokens carry them
+        return n.Pos(item.line, item.column)
+    return n.Pos(item.meta.line, item.meta.column)
+
+
+def _number(text: str) -> int | float:
+    text = text.strip()
+    if "." in text:
+        return float(text)
+    return int(text)
+
+
+class _ToNodes(Transformer):
+    """Tree -> nodes. Raises NcSyntaxError (wrapped by lark in VisitError) for invalid words."""
+
+    # --- expressions ------------------------------------------------------------------------
+    def number(self, items):
+        (tok,) = items
+        return n.Num(_number(tok.value), _pos(tok))
+
+    def string(self, items):
+        (tok,) = items
+        return n.Str(tok.value[1:-1], _pos(tok))
+
+    def true(self, items):
+        return n.Num(1, _pos(items[0]))
+
+    def false(self, items):
+        return n.Num(0, _pos(items[0]))
+
+    def rparam(self, items):
+        (tok,) = items
+        return n.Var("R", (n.Num(int(tok.value[1:]), n.Pos(tok.line, tok.column + 1)),), _pos(tok))
+
+    def name(self, items):
+        (tok,) = items
+        return n.Var(tok.value.upper(), (), _pos(tok))
+
+    def indexed(self, items):
+        tok, exprs = items
+        return n.Var(tok.value.upper(), tuple(exprs), _pos(tok))
+
+    def function(self, items):
+        tok, exprs = items
+        return n.Func(tok.value.upper(), tuple(exprs or ()), _pos(tok))
+
+    def exprs(self, items):
+        return list(items)
+
+    def binop(self, items):
+        left, op, right = items
+        return n.Binary(op.value.upper(), left, right, _pos(op))
+
+    def unop(self, items):
+        op, operand = items
+        return n.Unary(op.value.upper(), operand, _pos(op))
+
+    def set_list(self, items):
+        _set, exprs = items
+        return ("SET", tuple(exprs), _pos(_set))
+
+    # --- words --------------------------------------------------------------------------------
+    def address(self, items):
+        (tok,) = items
+        return _address_word(tok)
+
+    @v_args(meta=True)
+    def assignment(self, meta, items):
+        target, value = items
+        pos = n.Pos(meta.line, meta.column)
+        values, is_set = ((value[1], True) if isinstance(value, tuple) else ((value,), False))
+        name = target.name
+        if not target.indices and name in _ASSIGN_WORDS:
+            if is_set:
+                raise NcSyntaxError(f"{name}=SET(...) is not allowed; SET fills arrays", *_lc(pos))
+            return _ASSIGN_WORDS[name](name, values[0], pos)
+        if not target.indices and name in _EXAMPLES:
+            raise NcSyntaxError(f"{name}= is not allowed: write {name} with its number, e.g. {_EXAMPLES[name]}",
+                                *_lc(pos))
+        return n.Assign(target, values, pos, is_set)
+
+    def bare_name(self, items):
+        (tok,) = items
+        name = tok.value.upper()
+        pos = _pos(tok)
+        if name in AXIS_LETTERS or name in ("F", "S", "T", "D", "SPOS", "MEAS", "MEAW"):
+            raise NcSyntaxError(f"{name} needs a value (e.g. {name}10 or {name}=R1)"
+                                if len(name) == 1 else f"{name} needs a value: {name}=...", *_lc(pos))
+        if name in _STRUCTURED:
+            raise NcSyntaxError(f"{name}: structured control statements are not part of this control's "
+                                f"language (use IF ... GOTOF/GOTOB with labels)", *_lc(pos))
+        return n.CycleCall(name, (), pos)
+
+    def call(self, items):
+        tok, exprs = items
+        return n.CycleCall(tok.value.upper(), tuple(exprs or ()), _pos(tok))
+
+    def goto(self, items):
+        kw, target = items
+        value = target.value.upper()
+        if target.type == "BLOCKNO":
+            value = f"N{int(value[1:])}"
+        return n.Goto(kw.value.upper(), value, _pos(kw))
+
+    def msg(self, items):
+        kw, expr = items
+        return n.Msg(expr, _pos(kw))
+
+    def stopre(self, items):
+        return n.Stopre(_pos(items[0]))
+
+    def words(self, items):
+        return list(items)
+
+    def if_goto(self, items):
+        kw, cond, goto = items
+        return [n.IfGoto(cond, goto, _pos(kw))]
+
+    def type_length(self, items):
+        return int(items[0].value)
+
+    def dims(self, items):
+        return tuple(int(t.value) for t in items)
+
+    def def_item(self, items):
+        tok, dims, init = items
+        name = tok.value.upper()
+        pos = _pos(tok)
+        _check_user_name(name, pos)
+        if dims is not None and any(d < 1 for d in dims):
+            raise NcSyntaxError(f"DEF {name}: an array needs at least 1 element", *_lc(pos))
+        return n.DefItem(name, dims or (), init, pos)
+
+    def definition(self, items):
+        kw, type_tok, length, *defs = items
+        type_name = type_tok.value.upper()
+        if type_name not in TYPES:
+            raise NcSyntaxError(f"DEF {type_tok.value}: the type must be REAL, INT, BOOL or STRING[n]",
+                                *_lc(_pos(type_tok)))
+        if length is not None and type_name != "STRING":
+            raise NcSyntaxError(f"DEF {type_name}[{length}]: only STRING takes a length", *_lc(_pos(type_tok)))
+        return [n.Define(type_name, length, tuple(defs), _pos(kw))]
+
+    def label(self, items):
+        tok = items[0]
+        _check_user_name(tok.value.upper(), _pos(tok))
+        return ("LABEL", tok)
+
+
+def _lc(pos: n.Pos) -> tuple[int, int]:
+    return pos.line, pos.column
+
+
+def _check_user_name(name: str, pos: n.Pos) -> None:
+    if name in AXIS_LETTERS or name in ("F", "S", "T", "D", "G", "M", "N", "L", "R", "SPOS", "MEAS",
+                                        "MEAW") or name in TYPES:
+        raise NcSyntaxError(f"{name} is a word of the language and cannot be used as a name", *_lc(pos))
+
+
+def _address_word(tok: Token):
+    text = tok.value.upper()
+    letter, raw = text[0], text[1:]
+    pos = _pos(tok)
+    value = _number(raw)
+    if letter in ("G", "M", "L", "N"):
+        if not isinstance(value, int) or raw.startswith(("+", "-")):
+            raise NcSyntaxError(f"{tok.value}: {letter} takes a whole number", *_lc(pos))
+        if letter == "G":
+            return n.GCode(value, pos)
+        if letter == "M":
+            return n.MCode(value, pos)
+        if letter == "L":
+            return n.CycleCall(f"L{value}", (), pos)
+        raise NcSyntaxError(f"block number {tok.value} must stand at the start of the block", *_lc(pos))
+    num = n.Num(value, n.Pos(pos.line, pos.column + 1))
+    if letter in AXIS_LETTERS:
+        return n.AxisWord(letter, num, pos)
+    if letter in ("F", "S", "T", "D"):
+        return n.Address(letter, num, pos)
+    if letter == "R":
+        raise NcSyntaxError(f"{tok.value}: an R parameter has a number (R1) and is assigned with '='", *_lc(pos))
+    reason = _UNSUPPORTED_ADDRESS.get(letter, f"the address {letter} is not part of this control's language")
+    raise NcSyntaxError(f"{tok.value}: {reason}", *_lc(pos))
+
+
+_EXAMPLES = {"G": "G1", "M": "M30", "N": "N10", "L": "L977"}
+_ASSIGN_WORDS = {
+    **{a: (lambda name, value, pos: n.AxisWord(name, value, pos)) for a in AXIS_LETTERS},
+    **{a: (lambda name, value, pos: n.Address(name, value, pos)) for a in ("F", "S", "T", "D")},
+    "SPOS": lambda name, value, pos: n.Spos(value, pos),
+    "MEAS": lambda name, value, pos: n.Meas(name, value, pos),
+    "MEAW": lambda name, value, pos: n.Meas(name, value, pos),
+}
+
+
+# --- errors in operator words -------------------------------------------------------------------
+
+def _describe(tok: Token) -> str:
+    if tok.type == "_NL" or tok.type == "$END":
+        return "end of the block"
+    return f"'{tok.value}'"
+
+
+def _last_token(stack) -> Token | None:
+    for item in reversed(list(stack or ())):
+        if isinstance(item, Token):
+            return item
+        if isinstance(item, Tree):
+            tokens = [t for t in item.scan_values(lambda v: isinstance(v, Token))]
+            if tokens:
+                return max(tokens, key=lambda t: (t.line, t.column))
+        # transformed values are not expected (we transform after parsing)
+    return None
+
+
+def _show(value: str) -> str:
+    """A word as written (G1, X10, R1); punctuation in quotes ('=', '(')."""
+    return value if any(c.isalnum() for c in value) else f"'{value}'"
+
+
+def _after(prev: Token | None, line: int) -> str:
+    if prev is None or prev.type == "_NL" or prev.line != line:
+        return " at the start of the block"
+    return f" after {_show(prev.value)}"
+
+
+def _hint(expected: set[str]) -> str:
+    expected = {e for e in expected if not e.startswith("__")}
+    if not expected or "_NL" in expected:
+        return ""
+    if len(expected & _EXPRESSION_START) >= 3:
+        return ": a value or an expression is expected"
+    words = sorted({_TERMINAL_WORDS.get(e, e) for e in expected})
+    if len(words) > 4:
+        return ""
+    return ": expected " + (", ".join(words[:-1]) + " or " + words[-1] if len(words) > 1 else words[0])
+
+
+def _syntax_error(e: UnexpectedInput, lines: list[str]) -> NcSyntaxError:
+    line = getattr(e, "line", None) or 1
+    column = getattr(e, "column", None) or 1
+    text = lines[line - 1] if 0 < line <= len(lines) else None
+    if isinstance(e, UnexpectedToken):
+        stack = getattr(getattr(e, "state", None), "value_stack", None)
+        prev = _last_token(stack)
+        if prev is None and e.token_history:
+            prev = e.token_history[-1]
+        tok = e.token
+        if tok.type == "_NL":
+            message = f"the block ends too early{_after(prev, line)}"
+        else:
+            message = f"unexpected {_describe(tok)}{_after(prev, line)}"
+        if tok.value == "/" and _after(prev, line) == " at the start of the block":
+            message += ": block skip (/) is not part of this control's language"
+        else:
+            message += _hint(set(e.expected or ()))
+    elif isinstance(e, UnexpectedCharacters):
+        prev = e.token_history[-1] if getattr(e, "token_history", None) else None
+        char = e.char
+        message = f"unexpected character '{char}'{_after(prev, line)}"
+        if char == "/" and (prev is None or prev.line != line):
+            message += ": block skip (/) is not part of this control's language"
+    elif isinstance(e, UnexpectedEOF):
+        message = "the program ends too early"
+    else:  # pragma: no cover - lark has no other kinds
+        message = str(e)
+    return NcSyntaxError(message, line, column, alarm=alarms.NC_SYNTAX, block_text=text)
+
+
+# --- program ------------------------------------------------------------------------------------
+
+def parse_program(text: str, name: str = "MDA") -> n.Program:
+    """Parse and check ``text``; raises ``NcSyntaxError`` with line and column."""
+    if not isinstance(text, str):
+        raise TypeError("program text must be a str")
+    source = text.replace("\r\n", "\n").replace("\r", "\n")
+    lines = source.split("\n")
+    try:
+        tree = _lark().parse(source + "\n")
+    except UnexpectedInput as e:
+        raise _syntax_error(e, lines) from None
+    try:
+        raw_blocks = _ToNodes().transform(tree).children
+    except VisitError as e:
+        if isinstance(e.orig_exc, NcSyntaxError):
+            err = e.orig_exc
+            if err.line is not None and err.block_text is None and 0 < err.line <= len(lines):
+                err.block_text = lines[err.line - 1].strip()
+            raise err from None
+        raise
+    return _assemble(raw_blocks, source, lines, name)
+
+
+def _assemble(raw_blocks, source: str, lines: list[str], name: str) -> n.Program:
+    blocks: list[n.Block] = []
+    header = None
+    labels: dict[str, int] = {}
+    seen_instruction = False
+    for tree in raw_blocks:
+        line = tree.meta.line
+        text = lines[line - 1].strip()
+        if tree.data == "header_block":
+            tok = tree.children[0]
+            if blocks or header is not None:
+                raise NcSyntaxError("the program name line (%...) must be the first line", line, tok.column,
+                                    block_text=text)
+            header = tok.value
+            continue
+        number = None
+        label = None
+        words: list = []
+        for child in tree.children:
+            if child is None:
+                continue
+            if isinstance(child, Token) and child.type == "BLOCKNO":
+                number = int(child.value[1:])
+            elif isinstance(child, tuple) and child[0] == "LABEL":
+                tok = child[1]
+                label = tok.value.upper()
+                if label in labels:
+                    raise NcSyntaxError(f"label {label} is defined twice", tok.line, tok.column, block_text=text)
+                labels[label] = len(blocks)
+            else:
+                words.extend(child)
+        block = n.Block(len(blocks), line, text, number, label, tuple(words), n.Pos(line, tree.meta.column))
+        try:
+            _check_block(block)
+        except NcSyntaxError as err:
+            err.block_text = text
+            raise
+        is_def = any(isinstance(w, n.Define) for w in words)
+        if is_def and seen_instruction:
+            raise NcSyntaxError("DEF must come before the first instruction of the program", line,
+                                words[0].pos.column, block_text=text)
+        if words and not is_def:
+            seen_instruction = True
+        blocks.append(block)
+    program = n.Program(name, source, tuple(blocks), header, labels)
+    _check_jumps(program)
+    return program
+
+
+def _err(word, message: str, **kw) -> NcSyntaxError:
+    return NcSyntaxError(message, word.pos.line, word.pos.column, **kw)
+
+
+def _check_block(block: n.Block) -> None:
+    """Words that may not stand together in one block (independent of the configuration)."""
+    groups: dict[str, n.GCode] = {}
+    for g in block.gcodes():
+        group = g_group(g.number)
+        if group is None:
+            hint = " (circles G2/G3 are not part of this control's language)" if g.number in (2, 3) else ""
+            raise _err(g, f"G{g.number} is not a G function of this control{hint}",
+                       alarm=alarms.NC_G_FUNCTION_UNKNOWN)
+        if group in groups:
+            raise _err(g, f"G{g.number} and G{groups[group].number} exclude each other in one block")
+        groups[group] = g
+    for m in (w for w in block.words if isinstance(w, n.MCode)):
+        if m.number not in KNOWN_M:
+            raise _err(m, f"M{m.number} is not an M function of this control (M0 M2 M3 M4 M5 M6 M17 M30)")
+    ms = [w for w in block.words if isinstance(w, n.MCode)]
+    spindle = [m for m in ms if m.number in (3, 4, 5)]
+    if len(spindle) > 1:
+        raise _err(spindle[1], f"M{spindle[1].number} and M{spindle[0].number} exclude each other in one block")
+    ends = [m for m in ms if m.number in (0, 2, 17, 30)]
+    if len(ends) > 1:
+        raise _err(ends[1], f"M{ends[1].number} and M{ends[0].number} exclude each other in one block")
+    seen: dict[str, object] = {}
+    for w in block.words:
+        key = None
+        if isinstance(w, n.AxisWord):
+            key = w.axis
+        elif isinstance(w, n.Address):
+            key = w.letter
+        elif isinstance(w, n.Spos):
+            key = "SPOS"
+        elif isinstance(w, n.Meas):
+            key = "MEAS/MEAW"
+        elif isinstance(w, (n.Goto, n.IfGoto)):
+            key = "GOTO"
+        elif isinstance(w, n.Msg):
+            key = "MSG"
+        elif isinstance(w, n.MCode) and w.number == 6:
+            key = "M6"
+        if key is None:
+            continue
+        if key in seen:
+            raise _err(w, f"{key} is programmed twice in one block")
+        seen[key] = w
+    spos = next((w for w in block.words if isinstance(w, n.Spos)), None)
+    rotate = next((m for m in ms if m.number in (3, 4)), None)
+    if spos is not None and rotate is not None:
+        raise _err(spos, f"SPOS positions the stopped spindle: it cannot stand with M{rotate.number} in one block")
+    axes = [w for w in block.words if isinstance(w, n.AxisWord)]
+    meas = next((w for w in block.words if isinstance(w, n.Meas)), None)
+    calls = [w for w in block.words if isinstance(w, n.CycleCall)]
+    if len(calls) > 1:
+        raise _err(calls[1], f"only one cycle call per block ({calls[0].name} is already called)")
+    measuring = groups.get(MEASURING)
+    if measuring is not None:
+        code = measuring.number
+        others = [w for w in block.words if not isinstance(w, (n.AxisWord, n.GCode))
+                  and not (code == 100 and isinstance(w, (n.Address, n.Assign)) and _g100_extra_ok(w))]
+        if code in (101, 102):
+            for g in block.gcodes():
+                if g is not measuring:
+                    raise _err(g, f"G{code} takes axis factors only: program G{g.number} in another block")
+            if others:
+                raise _err(others[0], f"G{code} takes axis factors only: program this in another block")
+            if code == 101 and not axes:
+                raise _err(measuring, "G101 needs at least one axis with its factor, e.g. G101 X1")
+        else:  # G100
+            if MOTION in groups:
+                raise _err(groups[MOTION], f"G100 is itself the measuring move: leave out G{groups[MOTION].number}")
+            if FRAME_SUPPRESS in groups:
+                raise _err(groups[FRAME_SUPPRESS], "G100 measures in the workpiece coordinates: leave out G53")
+            if len(axes) == 1 and axes[0].axis not in ("X", "Y", "Z"):
+                raise _err(axes[0], f"G100 measures a geometry axis (X, Y, Z), not {axes[0].axis}")
+            if len(axes) != 1:
+                raise _err(measuring if not axes else axes[1],
+                           "G100 measures one axis: program G100 with exactly one axis and its target, "
+                           "a separate G100 block for each axis")
+            if meas is not None:
+                raise _err(meas, "G100 is itself the measuring move: leave out MEAS/MEAW")
+    if meas is not None:
+        if not axes:
+            raise _err(meas, f"{meas.kind} needs an axis motion in the same block (e.g. {meas.kind}=1 G1 X100)")
+        motion = groups.get(MOTION)
+        if motion is not None and motion.number == 0:
+            raise _err(motion, f"{meas.kind} is a measuring move at feed: program G1, not G0")
+
+
+def _g100_extra_ok(word) -> bool:
+    """Words a G100 block may hold besides its axis: F (measuring feed) and assignments."""
+    return isinstance(word, n.Assign) or (isinstance(word, n.Address) and word.letter == "F")
+
+
+def _check_jumps(program: n.Program) -> None:
+    for b in program.blocks:
+        for w in b.words:
+            goto = w.goto if isinstance(w, n.IfGoto) else w if isinstance(w, n.Goto) else None
+            if goto is None:
+                continue
+            if find_jump(program, b.index, goto) is None:
+                where = {"GOTOF": " after this block", "GOTOB": " before this block", "GOTO": ""}[goto.direction]
+                raise NcSyntaxError(f"{goto.direction} {goto.target}: there is no label or block "
+                                    f"{goto.target}{where}", goto.pos.line, goto.pos.column,
+                                    alarm=alarms.NC_JUMP_TARGET, block_text=b.text)
+
+
+def find_jump(program: n.Program, from_index: int, goto: n.Goto) -> int | None:
+    """Index of the block ``goto`` jumps to from block ``from_index`` (840D search rules)."""
+    def matches(block: n.Block) -> bool:
+        if goto.target.startswith("N") and goto.target[1:].isdigit():
+            if block.number == int(goto.target[1:]):
+                return True
+        return block.label == goto.target
+
+    forward = range(from_index + 1, len(program.blocks))
+    backward = range(from_index - 1, -1, -1)
+    if goto.direction == "GOTOF":
+        order = list(forward)
+    elif goto.direction == "GOTOB":
+        order = list(backward)
+    else:  # GOTO: forward first, then backward (840D)
+        order = list(forward) + list(backward)
+    return next((i for i in order if matches(program.blocks[i])), None)
+
+
+def parse_reference(text: str) -> n.Var:
+    """A variable reference as the API names it: ``R1``, ``R[5]``, ``_EV[9]``, ``$AA_MM[X]``."""
+    try:
+        program = parse_program(f"__REF__={text}", name="REF")
+    except NcSyntaxError as e:
+        raise NcSyntaxError(f"{text!r} is not a variable reference", None, None) from e
+    block = program.blocks[0] if len(program.blocks) == 1 else None
+    words = block.words if block else ()
+    if len(words) != 1 or not isinstance(words[0], n.Assign) or len(words[0].values) != 1 \
+            or not isinstance(words[0].values[0], n.Var):
+        raise NcSyntaxError(f"{text!r} is not a variable reference", None, None)
+    return words[0].values[0]

@@ -1,0 +1,51 @@
+"""Who is connected: the OPC UA user name token is checked against the HMI's users (design.md
+jog-measuring §9.2: the same argon2 hashes, lockout and levels as ``POST /api/session``); an anonymous session
+reads only. Nobody is ever asyncua's ``Admin`` (which could add and delete nodes)."""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+from asyncua import ua
+from asyncua.crypto.permission_rules import USER_TYPES, PermissionRuleset, User, UserRole
+from asyncua.server.user_managers import UserManager
+
+from app.access.service import AccessService, SignInRefused
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class HmiUser(User):
+    """A signed-in HMI user; the level is read again at every write (it may have changed)."""
+
+    level: int | None = None
+
+
+class HmiUserManager(UserManager):
+    def __init__(self, access: AccessService):
+        self._access = access
+
+    def get_user(self, iserver, username: str | None = None, password: str | None = None,
+                 certificate=None) -> User | None:
+        """None refuses the session (asyncua answers BadUserAccessDenied)."""
+        if username is None:
+            return User(role=UserRole.Anonymous)
+        try:
+            identity = self._access.verify_password(username, password or "")
+        except SignInRefused as exc:
+            log.warning("OPC UA sign-in of %r refused: %s", username, exc.message)
+            return None
+        return HmiUser(role=UserRole.User, name=identity.name, level=identity.level)
+
+
+class HmiRuleset(PermissionRuleset):
+    """Which requests a session may send: anonymous and users the same (read, browse, subscribe,
+    call, write; what a write may change is checked per node), nobody the node management ones."""
+
+    def __init__(self):
+        self._allowed = {ua.NodeId(ua.Int32(action)) for action in USER_TYPES}
+
+    def check_validity(self, user, action_type_id, body) -> bool:
+        return action_type_id in self._allowed

@@ -1,0 +1,49 @@
+"""The EV and MV memories of the tool-offset strategy (measuring-math §3.3, design.md §9.3).
+
+``n`` is the memory number of _EVNUM (n = 10 is ``_EV[9]``), 1..MEMORY_COUNT (_EVMVNUM, the
+manual's default 20 each). Reads give 0 for a memory never written; every write is audited.
+"""
+
+from __future__ import annotations
+
+import math
+
+from app.errors import InvalidInput
+from db import Database
+
+MEMORY_COUNT = 20
+KINDS = {"ev": "EV", "mv": "MV"}
+MAX_VALUE = 1000.0          # mm: a memory beyond is a typo
+
+
+class MemoryService:
+    def __init__(self, db: Database):
+        self._db = db
+
+    @staticmethod
+    def _key(kind: str, n) -> tuple[str, int]:
+        if kind not in KINDS:
+            raise InvalidInput("kind: must be ev or mv", field="kind")
+        if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MEMORY_COUNT:
+            raise InvalidInput(f"n: memory number 1..{MEMORY_COUNT}", field="n")
+        return KINDS[kind], n
+
+    def get(self, kind: str, n: int) -> dict:
+        name, n = self._key(kind, n)
+        with self._db.unit(readonly=True) as unit:
+            return {"kind": kind, "n": n, "value": unit.get_memory(name, n)}
+
+    def list(self) -> dict:
+        with self._db.unit(readonly=True) as unit:
+            stored = {kind: unit.list_memories(name) for kind, name in KINDS.items()}
+        return {kind: [{"n": n, "value": values.get(n, 0.0)} for n in range(1, MEMORY_COUNT + 1)]
+                for kind, values in stored.items()}
+
+    def put(self, kind: str, n: int, value, source: str = "api") -> dict:
+        name, n = self._key(kind, n)
+        if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value) \
+                or abs(value) > MAX_VALUE:
+            raise InvalidInput(f"value: a finite number within ±{MAX_VALUE:g} mm", field="value")
+        with self._db.unit() as unit:
+            unit.put_memory(name, n, float(value), source=source)
+        return {"kind": kind, "n": n, "value": float(value)}

@@ -1,0 +1,582 @@
+"""Part programs on the product's machine (design.md §9.4): the NC runtime over the machine
+service, the measuring environment of the cycles, one NC channel (MDA / AUTOMATIC) and the
+stored programs.
+
+- ``MachineRuntime`` implements ``app.nc.runtime.NcRuntime`` on ``MachineService``: motion and
+  probing through the ``Machine`` Protocol, frames from the stored offsets (``build_chain``),
+  activation and tool change through the machine service (so that JOG, the database and the
+  machine agree), tool lengths L1 = geometry + wear from the tool table.
+- ``NcMeasuringEnv`` is the JOG ``MeasuringEnv`` as a cycle sees it: the program's plane, the
+  cycle's measuring path/feed/bits in place of the JOG settings, the program and block in the
+  log entry; everything else (context snapshot, one-transaction commit, activation) is JOG's.
+- ``NcService``: the channel. One interpreter (its modal state persists between runs like a real
+  channel), run in a worker thread; ``run`` loads the MDA text or a stored program and starts it,
+  ``start`` continues after M0 / single block / NC Stop, ``stop``, ``reset``; the mode (JOG, MDA,
+  AUTO) is what the header and ``GET /api/machine`` show.
+- ``ProgramService``: the programs table.
+"""
+
+from __future__ import annotations
+
+import contextvars
+import dataclasses
+import logging
+import re
+import threading
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from app.errors import ConflictError, HmiError, InvalidInput, NotFoundError
+from app.machine.protocol import MachineAlarm, MachineBusy
+from app.nc import Interpreter, NcRuntimeError, NcStateError, NcSyntaxError, VariableError, Variables
+from app.nc.cycles import measuring_cycles
+from app.nc.interpreter import CycleContext
+from app.nc.runtime import MeasureResult
+from app.services.machine_service import MachineService
+from app.services.measuring import MeasuringEnv
+from app.services.memories import MEMORY_COUNT
+from app.services.settings import SettingsService
+from app.workflow.service import WorkflowService
+from db import Database
+from engine import alarms
+from engine.frames import G500, FrameChain, is_basic
+from engine.planes import plane as plane_by_name
+
+log = logging.getLogger(__name__)
+
+XYZ = ("X", "Y", "Z")
+MDA = "MDA"
+PROGRAM_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,31}$")
+
+
+# --- the runtime -----------------------------------------------------------------------------------
+
+class MachineRuntime:
+    """``NcRuntime`` on the machine service (see the module docstring)."""
+
+    def __init__(self, machine_service: MachineService, db: Database):
+        self._ms = machine_service
+        self._db = db
+        self._edge = 1
+        self._tools: tuple[int, dict] | None = None
+
+    @property
+    def _machine(self):
+        return self._ms.machine
+
+    @staticmethod
+    def _error(alarm) -> NcRuntimeError:
+        definition = alarms.by_number(alarm.code) or alarms.NC_INTERNAL
+        if alarm.code == alarms.PROBE_BROKEN.number:
+            definition = alarms.PROBE_COLLISION if alarm.resettable else alarms.PROBE_BROKEN
+        return NcRuntimeError(alarm.text, definition)
+
+    def _checked(self, call):
+        try:
+            return call()
+        except MachineAlarm as exc:
+            raise self._error(exc.alarm) from None
+        except MachineBusy as exc:
+            raise NcRuntimeError(str(exc) or "a motion is running", alarms.NC_INTERNAL) from None
+        except HmiError as exc:
+            raise NcRuntimeError(exc.message, alarms.NC_VALUE_RANGE) from None
+        except ValueError as exc:
+            raise NcRuntimeError(str(exc), alarms.NC_VALUE_RANGE) from None
+
+    # --- NcRuntime ---------------------------------------------------------------------------
+    @property
+    def axes(self) -> tuple[str, ...]:
+        return self._ms.axes
+
+    def position(self) -> dict[str, float]:
+        return {a: float(v) for a, v in self._machine.status().mcs.items()}
+
+    def move(self, target_mcs: Mapping[str, float], feed: float | None) -> None:
+        result = self._checked(lambda: self._machine.goto({a: float(v) for a, v in target_mcs.items()}, feed))
+        if not result.completed:
+            if result.alarm is not None:
+                raise self._error(result.alarm)
+            raise NcRuntimeError("motion aborted", alarms.RESET_ABORT)
+
+    def measure(self, target_mcs: Mapping[str, float], feed: float, stop_on_trigger: bool) -> MeasureResult:
+        start = self._machine.status().mcs
+        d = np.array([float(target_mcs.get(a, start[a])) - float(start[a]) for a in XYZ])
+        distance = float(np.linalg.norm(d))
+        if distance == 0.0:
+            raise NcRuntimeError("measuring move without path", alarms.NO_MEASURING_PATH)
+        before = len(self._machine.status().alarms)
+        result = self._checked(lambda: self._machine.probe(d / distance, distance, feed))
+        new = self._machine.status().alarms[before:]
+        if new:                                   # broken probe, limit switch
+            raise self._error(new[-1])
+        if result.triggered and not stop_on_trigger:
+            # MEAW: on to the end point (the simulator's stylus cannot be pushed on: a remaining
+            # path is a collision there, as a real probe would be deflected further)
+            self.move(target_mcs, feed)
+        return MeasureResult(bool(result.triggered), dict(result.latched_mcs) if result.triggered else None)
+
+    def offset_chain(self, name: str) -> FrameChain:
+        if name != G500 and (is_basic(name) or name not in self._db.offset_names()):
+            raise NcRuntimeError(f"zero offset {name} does not exist", alarms.ZO_NUMBER)
+        return self._ms.build_chain(name)
+
+    def active_offset(self) -> str:
+        return self._ms.active_offset
+
+    def activate_offset(self, name: str) -> None:
+        self.offset_chain(name)
+        self._checked(lambda: self._ms.activate(name))
+
+    def tool_state(self) -> tuple[int | None, int]:
+        tool = self._machine.status().tool
+        return tool, (self._edge if tool is not None else 0)
+
+    def _tool_row(self, tool: int) -> dict | None:
+        generation = self._db.generation
+        if self._tools is None or self._tools[0] != generation:
+            with self._db.unit(readonly=True) as unit:
+                self._tools = (generation, {t["t"]: t for t in unit.list_tools()})
+        return self._tools[1].get(tool)
+
+    def tool_length(self, tool: int | None, edge: int) -> float:
+        if tool is None or edge == 0:
+            return 0.0
+        row = self._tool_row(tool)
+        if row is None:
+            raise NcRuntimeError(f"T{tool} is not in the tool list", alarms.NO_TOOL_FOR_IDENTIFIER)
+        if edge != 1:
+            raise NcRuntimeError(f"T{tool} has only D1", alarms.NC_D_NUMBER)
+        return float(MachineService.offset_length(row))
+
+    def change_tool(self, tool: int | None, edge: int) -> None:
+        self.tool_length(tool, edge)
+        self._checked(lambda: self._ms.change_tool(tool if tool is not None else 0))
+        self._edge = edge
+        if tool is not None and edge == 0:
+            self._checked(lambda: self._machine.set_tool_offset(0.0))
+
+    def select_edge(self, edge: int) -> None:
+        tool = self._machine.status().tool
+        length = self.tool_length(tool, edge)
+        self._checked(lambda: self._machine.set_tool_offset(length))
+        self._edge = edge
+
+    def spindle(self, direction: int, speed: float) -> None:
+        self._checked(lambda: self._machine.spindle_rotate(float(speed) if direction else 0.0))
+
+    def spindle_position(self, angle: float) -> None:
+        self._checked(lambda: self._machine.spindle_position(float(angle)))
+
+
+# --- the measuring environment of a cycle ----------------------------------------------------------
+
+class NcMeasuringEnv:
+    """``WorkflowEnv`` of one cycle call: JOG's ``MeasuringEnv`` with the program's plane and the
+    cycle's settings, the program and block in the log."""
+
+    def __init__(self, base: MeasuringEnv, plane: str, settings: Mapping[str, Any], log_extra: Mapping[str, Any]):
+        self._base = base
+        self._plane = plane_by_name(plane)
+        self._settings = dict(settings)
+        self._log = dict(log_extra)
+
+    @property
+    def machine(self):
+        return self._base.machine
+
+    def _gud(self, gud):
+        known = {k: v for k, v in self._settings.items() if k in type(gud).model_fields}
+        return gud.model_copy(update=known)
+
+    def measuring_setup(self):
+        setup = self._base.measuring_setup()
+        return dataclasses.replace(setup, plane=self._plane, settings=self._gud(setup.settings))
+
+    def measuring_context(self):
+        ctx = self._base.measuring_context()
+        return dataclasses.replace(ctx, plane=self._plane, settings=self._gud(ctx.settings))
+
+    def commit_measurement(self, *, log_entry: dict, **commit):
+        entry = dict(log_entry)
+        entry["program"] = self._log.get("program")
+        entry["block"] = self._log.get("block")
+        entry["params"] = {**(entry.get("params") or {}), "cycle": self._log.get("cycle")}
+        return self._base.commit_measurement(log_entry=entry, **commit)
+
+    def activate(self, name: str) -> None:
+        self._base.activate(name)
+
+    def refresh_frames(self) -> None:
+        self._base.refresh_frames()
+
+    def post_alarm(self, code: int, text: str) -> None:
+        self._base.post_alarm(code, text)
+
+
+class _CycleMeasuring:
+    """``app.nc.cycles.NcMeasuring`` over an ``NcMeasuringEnv``."""
+
+    def __init__(self, env: NcMeasuringEnv):
+        self._env = env
+
+    def setup(self):
+        return self._env.measuring_setup()
+
+    def context(self):
+        return self._env.measuring_context()
+
+    def workflow(self, tasks):
+        return WorkflowService(self._env, tasks)
+
+
+def _json_ready(value):
+    if isinstance(value, dict):
+        return {str(k): _json_ready(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_json_ready(v) for v in value]
+    return value
+
+
+# --- the channel --------------------------------------------------------------------------------------
+
+class NcSyntaxInput(InvalidInput):
+    """A program that cannot run as written: 422 naming line and column, nothing moved."""
+
+    code = "nc_syntax"
+
+    def __init__(self, error: NcSyntaxError, field: str):
+        super().__init__(str(error), field=field)
+        self.detail = error.to_dict()
+
+
+class NcService:
+    """One NC channel (CHAN1): the interpreter, its worker thread, the mode, the MDA buffer."""
+
+    def __init__(self, db: Database, machine_service: MachineService, env: MeasuringEnv,
+                 settings: SettingsService):
+        self._db = db
+        self._ms = machine_service
+        self._env = env
+        self._settings = settings
+        self.runtime = MachineRuntime(machine_service, db)
+        self.variables = Variables(axes=machine_service.axes, backings={
+            "_EV": _memory_backing(db, "EV"), "_MV": _memory_backing(db, "MV")})
+        self.cycles = measuring_cycles(self)
+        self.interpreter = Interpreter(self.runtime, self.variables, self.cycles)
+        self._lock = threading.RLock()
+        self._thread: threading.Thread | None = None
+        self._source: str | None = None           # "MDA" or the name of the stored program loaded
+        self._text: str = ""                      # the text loaded (MDA buffer or program)
+        self.mda_text: str = ""                   # the MDA editor's buffer
+        self.single_block = False
+        self._crash: str | None = None
+        self._authorize = None                    # the access check of who started the run
+
+    # --- cycle host ------------------------------------------------------------------------------
+    def authorize(self, category, target) -> None:
+        """A cycle is about to write into ``target``: the level of who started the run must
+        allow it (the API and the screens hand in their check with the run)."""
+        if self._authorize is not None:
+            self._authorize(category, target)
+
+    def measuring(self, ctx: CycleContext, settings: Mapping[str, Any], cycle: Mapping[str, Any]):
+        block = ctx.block
+        text = block.text.strip()
+        log_extra = {"program": self._source or MDA, "block": (f"L{block.line}: {text}")[:200],
+                     "cycle": _json_ready({**cycle, "block": block.number, "line": block.line})}
+        return _CycleMeasuring(NcMeasuringEnv(self._env, ctx.modal.plane, settings, log_extra))
+
+    # --- state -------------------------------------------------------------------------------------
+    @property
+    def loaded_text(self) -> str:
+        """The text of the program in the channel ("" when none)."""
+        return self._text if self._source is not None else ""
+
+    @property
+    def running(self) -> bool:
+        return self._thread is not None and self._thread.is_alive()
+
+    @property
+    def mode(self) -> str:
+        """JOG, or MDA/AUTO while a program is active (running, interrupted, in alarm, or
+        selected for AUTOMATIC and not yet started)."""
+        state = self.interpreter.state
+        if self._source is None:
+            return "JOG"
+        if state in ("running", "stopped", "alarm") or self.running:
+            return MDA if self._source == MDA else "AUTO"
+        if state == "ready" and self._source != MDA:
+            return "AUTO"
+        return "JOG"
+
+    def status(self) -> dict:
+        st = self.interpreter.status()
+        last = self.interpreter.last_result
+        alarm = st["alarm"]
+        if self._crash and alarm is None and st["state"] == "alarm":
+            alarm = {"code": alarms.NC_INTERNAL.number, "message": self._crash}
+        state = "running" if self.running else ("idle" if self._source is None else st["state"])
+        return {"mode": self.mode, "program": self._source, "block": st["block"] if self._source else None,
+                "state": state, "alarm": alarm,
+                "reason": last.reason if last else None, "single_block": self.single_block,
+                "message": st["message"], "modal": st["modal"]}
+
+    def result(self) -> dict:
+        """The design.md §9.4 answer of a run: state, block, alarm (+ reason, mode, program)."""
+        st = self.status()
+        last = self.interpreter.last_result
+        block = last.block.to_dict() if last and last.block else st["block"]
+        state = st["state"]
+        if state in ("ready", "idle"):
+            state = "stopped"
+        return {"state": state, "block": block, "alarm": st["alarm"], "reason": st["reason"],
+                "mode": st["mode"], "program": st["program"]}
+
+    # --- programs into the channel -------------------------------------------------------------------
+    def check(self, text: str, name: str = MDA) -> dict | None:
+        """The syntax check of ``text`` as a load would make it (None = runs), without loading."""
+        probe = Interpreter(self.runtime, Variables(axes=self._ms.axes), self.cycles)
+        try:
+            probe.load(text, name)
+        except NcSyntaxError as exc:
+            return exc.to_dict()
+        return None
+
+    def _load(self, text: str, source: str, field: str) -> None:
+        if self.running:
+            raise ConflictError("a program is running: NC Stop or Reset first", code="busy")
+        try:
+            self.interpreter.load(text, source)
+        except NcSyntaxError as exc:
+            raise NcSyntaxInput(exc, field) from None
+        except NcStateError as exc:
+            raise ConflictError(str(exc), code="busy") from None
+        self._source, self._text, self._crash = source, text, None
+
+    def _program_text(self, name: str) -> str:
+        with self._db.unit(readonly=True) as unit:
+            program = unit.get_program(name)
+        if program is None:
+            raise NotFoundError(f"program {name!r} does not exist", field="program", code="unknown_program")
+        return program["text"]
+
+    def select(self, name: str) -> dict:
+        """Select a stored program for AUTOMATIC (loaded, ready for NC Start)."""
+        with self._lock:
+            self._load(self._program_text(name), name, "program")
+        return self.status()
+
+    def run(self, *, program: str | None = None, mda: str | None = None, wait: bool = True,
+            single_block: bool | None = None, authorize=None) -> dict:
+        """Load the MDA text or a stored program and start it from its first block."""
+        if (program is None) == (mda is None):
+            raise InvalidInput("give either program (a stored program's name) or mda (the text)", field="program")
+        with self._lock:
+            if program is not None:
+                self._load(self._program_text(program), program, "program")
+            elif mda is not None:                 # always here: exactly one of them was given
+                self.mda_text = mda
+                self._load(mda, MDA, "mda")
+            if single_block is not None:
+                self.single_block = bool(single_block)
+            self._launch(authorize)
+        return self._answer(wait)
+
+    def start(self, *, wait: bool = True, single_block: bool | None = None, authorize=None) -> dict:
+        """NC Start: continue the loaded program (after M0, single block, NC Stop), or run it
+        again from the start when it has ended."""
+        with self._lock:
+            if self.running:
+                raise ConflictError("the program is already running", code="busy")
+            state = self.interpreter.state
+            if state == "idle" or self._source is None:
+                raise ConflictError("no program loaded: run an MDA text or select a program", code="no_program")
+            if state == "alarm":
+                raise ConflictError("the channel has an alarm: press Reset first", code="alarm")
+            if state == "done":
+                self.interpreter.load(self._text, self._source)
+            if single_block is not None:
+                self.single_block = bool(single_block)
+            self._launch(authorize)
+        return self._answer(wait)
+
+    def _launch(self, authorize=None) -> None:
+        machine = self._ms.machine.status()
+        if machine.busy:
+            raise ConflictError("the machine is moving: wait or press Reset", code="busy")
+        single = self.single_block
+        interp = self.interpreter
+
+        def work() -> None:
+            try:
+                interp.step() if single else interp.run()
+            except Exception as exc:           # an interpreter bug: the channel shows it
+                log.exception("NC channel crashed")
+                self._crash = f"internal error: {exc}"
+
+        self._authorize = authorize
+        context = contextvars.copy_context()        # who pressed NC Start acts in the thread too (audit)
+        thread = threading.Thread(target=context.run, args=(work,), name="nc-channel", daemon=True)
+        self._thread = thread
+        thread.start()
+
+    def _answer(self, wait: bool) -> dict:
+        thread = self._thread
+        if wait and thread is not None:
+            thread.join()
+            return self.result()
+        return {**self.result(), "state": "running" if self.running else self.result()["state"]}
+
+    def wait(self, timeout: float | None = None) -> dict:
+        thread = self._thread
+        if thread is not None:
+            thread.join(timeout)
+        return self.result()
+
+    def stop(self) -> dict:
+        """NC Stop: the program stops at the end of the block (a cycle between its points)."""
+        self.interpreter.request_stop()
+        return self.status()
+
+    def reset(self) -> dict:
+        """NC Reset: abort the program (and its motion), modal state to the defaults, measuring
+        offsets cleared, the machine's alarms cleared, the program deselected; mode JOG."""
+        with self._lock:
+            if self.running:
+                self.interpreter.request_stop()
+                self._ms.machine.reset()
+                thread = self._thread
+                if thread is not None:
+                    thread.join(30.0)
+            if self.running:
+                raise ConflictError("the program does not stop: try again", code="busy")
+            self.interpreter.reset()
+            self._ms.machine.reset()
+            self._source, self._crash = None, None
+        return self.status()
+
+    def set_single_block(self, on: bool) -> dict:
+        self.single_block = bool(on)
+        return self.status()
+
+    # --- variables -----------------------------------------------------------------------------------
+    def read_variables(self, names: list[str]) -> dict:
+        out = {}
+        for name in names:
+            try:
+                out[name] = _json_ready(self.variables.read(name))
+            except VariableError as exc:
+                raise NotFoundError(f"{name}: {exc.message}", field="names", code="unknown_variable") from None
+        return out
+
+    def write_variable(self, name: str, value) -> dict:
+        if self.running:
+            raise ConflictError("a program is running: write the variable when it has stopped", code="busy")
+        if isinstance(value, bool) or not isinstance(value, int | float | str):
+            raise InvalidInput("value: a number or a text", field="value")
+        try:
+            self.variables.write(name, value)
+            return {name: _json_ready(self.variables.read(name))}
+        except VariableError as exc:
+            status = NotFoundError if type(exc).__name__ == "UnknownVariable" else InvalidInput
+            raise status(f"{name}: {exc.message}", field="name" if status is NotFoundError else "value") from None
+
+    def close(self) -> None:
+        if self.running:
+            self.interpreter.request_stop()
+            thread = self._thread
+            if thread is not None:
+                thread.join(5.0)
+
+
+def _memory_backing(db: Database, kind: str):
+    """_EV[i] / _MV[i] = memory n = i + 1 of the database (the same memories JOG uses)."""
+    from app.nc import CallbackBacking
+
+    def read(key):
+        n = int(key) + 1
+        if not 1 <= n <= MEMORY_COUNT:
+            return None
+        with db.unit(readonly=True) as unit:
+            return unit.get_memory(kind, n)
+
+    def write(key, value):
+        n = int(key) + 1
+        if not 1 <= n <= MEMORY_COUNT:
+            raise VariableError(f"_{kind}[{key}]: memory {n} is beyond the {MEMORY_COUNT} memories")
+        with db.unit() as unit:
+            unit.put_memory(kind, n, float(value), source="nc")
+
+    return CallbackBacking(read, write)
+
+
+# --- stored programs ----------------------------------------------------------------------------------
+
+class ProgramService:
+    """The programs table (design.md §9.4): names of letters, digits and _, starting with a letter."""
+
+    def __init__(self, db: Database, nc: NcService):
+        self._db = db
+        self._nc = nc
+
+    @staticmethod
+    def check_name(name) -> str:
+        if not isinstance(name, str) or not PROGRAM_NAME.match(name):
+            raise InvalidInput("name: 1..32 letters, digits or _, starting with a letter", field="name")
+        return name
+
+    @staticmethod
+    def _check_text(text) -> str:
+        if not isinstance(text, str):
+            raise InvalidInput("text: the program text", field="text")
+        if len(text) > 200_000:
+            raise InvalidInput("text: at most 200000 characters", field="text")
+        return text
+
+    def _with_check(self, program: dict) -> dict:
+        return {**program, "syntax": self._nc.check(program["text"], program["name"]),
+                "selected": self._nc.status()["program"] == program["name"]}
+
+    def list(self) -> list[dict]:
+        with self._db.unit(readonly=True) as unit:
+            return unit.list_programs()
+
+    def get(self, name: str) -> dict:
+        with self._db.unit(readonly=True) as unit:
+            program = unit.get_program(name)
+        if program is None:
+            raise NotFoundError(f"program {name!r} does not exist", field="name", code="unknown_program")
+        return self._with_check(program)
+
+    def create(self, name, text) -> dict:
+        name, text = self.check_name(name), self._check_text(text)
+        with self._db.unit() as unit:
+            if unit.get_program(name) is not None:
+                raise ConflictError(f"program {name} exists already: PUT to change it", field="name",
+                                    code="exists")
+            program, _ = unit.put_program(name, text)
+        return self._with_check(program)
+
+    def put(self, name, text) -> tuple[dict, bool]:
+        name, text = self.check_name(name), self._check_text(text)
+        self._refuse_active(name, "changed")
+        with self._db.unit() as unit:
+            program, created = unit.put_program(name, text)
+        return self._with_check(program), created
+
+    def delete(self, name: str) -> None:
+        self._refuse_active(name, "deleted")
+        with self._db.unit() as unit:
+            try:
+                unit.delete_program(name)
+            except KeyError:
+                raise NotFoundError(f"program {name!r} does not exist", field="name",
+                                    code="unknown_program") from None
+
+    def _refuse_active(self, name: str, what: str) -> None:
+        st = self._nc.status()
+        if st["program"] == name and (st["state"] in ("running", "stopped") or self._nc.running):
+            raise ConflictError(f"program {name} is active in the channel: Reset before it is {what}",
+                                code="busy")

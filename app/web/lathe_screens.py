@@ -1,0 +1,162 @@
+"""What the lathe tasks' input screens show besides the common ones (turning.md §10.1, turning §10.2).
+
+The screens are the common task screens (app/web/task_screens.py, templates/measure_task.html)
+with the lathe's fields (app.workflow.forms.lathe_form); this module gives them the result and
+correction rows in the lathe's terms (L1/L2/SL, trigger values per travel direction, X as a
+diameter where the cycle reports it so, labelled), the tool in the turret, and the live view:
+the real set-up drawn X up / Z right with the planned path of the NC reference point.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from markupsafe import Markup
+
+from app.workflow.executor import StepExecutor
+from engine.turning_plan import lathe_planned_path, prepare
+from engine.types import MoveStep, ProbeStep
+
+from .lathe_view import lathe_svg
+from .templating import fmt_result
+
+DIA = "mm Ø"
+
+
+def lathe_result_rows(result: dict) -> list[tuple[str, str, str]]:
+    """(label, value text, unit): the turning §10.2 result keys; diameters labelled as such."""
+    rows: list[tuple[str, str, str]] = []
+    unit = DIA if result.get("unit") == "diameter" else "mm"
+    for key, label in (("diameter", "Diameter"), ("actual", "Actual value"), ("setpoint", "Setpoint"),
+                       ("deviation", "Deviation D"), ("mean_value", "Mean value Mv"),
+                       ("empirical_value", "Empirical value EV")):
+        value = result.get(key)
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            if key == "actual" and "diameter" in result:
+                continue                          # CYCLE994: its actual value is the diameter
+            rows.append((label, fmt_result(key, value), unit))
+    if isinstance(result.get("compensation"), int | float):
+        rows.append(("Compensation (radius)", fmt_result("compensation", result["compensation"]), "mm"))
+    for name, data in (result.get("length") or {}).items():
+        rows.append((f"{name} measured", fmt_result("length", data["actual"]), "mm"))
+        rows.append((f"{name} difference", fmt_result("length", data["difference"]), "mm"))
+    if isinstance(result.get("radius"), dict):
+        rows.append(("R measured", fmt_result("radius", result["radius"]["actual"]), "mm"))
+    for key, value in (result.get("trigger") or {}).items():
+        rows.append((f"Trigger {key}", fmt_result("trigger", value), "mm"))
+        diff = (result.get("difference") or {}).get(key) if isinstance(result.get("difference"), dict) else None
+        if diff is not None:
+            rows.append((f"Difference {key}", fmt_result("difference", diff), "mm"))
+    for axis, value in (result.get("skew") or {}).items():
+        rows.append((f"Position deviation {axis}", fmt_result("skew", value), "mm"))
+    if isinstance(result.get("effective_diameter"), int | float):
+        rows.append(("Effective ball diameter", fmt_result("d", result["effective_diameter"]), "mm"))
+    if result.get("written"):
+        rows.append(("Written", ", ".join(result["written"]), ""))
+    return rows
+
+
+LATHE_TOOL_FIELDS = (("l1", "L1"), ("l2", "L2"), ("radius", "R"))
+
+
+def lathe_correction_rows(correction: dict) -> list[dict]:
+    """Before/after rows of what a lathe task wrote: tool data (L1, L2, R and their wear), the
+    tool probe faces (_TP), the probe record (_WP trigger values, diameter, position deviation)
+    or a zero offset (its translations)."""
+    before, after = correction.get("before") or {}, correction.get("after") or {}
+    rows: list[dict] = []
+
+    def add(label: str, field: str, old, new) -> None:
+        if new is None:
+            return
+        old = 0.0 if old is None else float(old)
+        rows.append({"label": label, "field": field, "before": fmt_result("length", old),
+                     "after": fmt_result("length", float(new)), "changed": abs(float(new) - old) > 1e-9})
+
+    if "trans" in after:
+        for axis, new in (after.get("trans") or {}).items():
+            add(f"Offset {axis}", f"trans.{axis}", (before.get("trans") or {}).get(axis), new)
+        return rows
+    if "l1" in after:
+        for key, label in LATHE_TOOL_FIELDS:
+            add(label, key, before.get(key), after.get(key))
+        for key, label in LATHE_TOOL_FIELDS:
+            add(f"Wear {label}", f"wear.{key}", (before.get("wear") or {}).get(key), (after.get("wear") or {}).get(key))
+        return rows
+    if "trigger" in after:
+        for key, new in (after.get("trigger") or {}).items():
+            add(f"Trigger {key}", f"trigger.{key}", (before.get("trigger") or {}).get(key), new)
+        add("Effective diameter", "effective_diameter", before.get("effective_diameter"),
+            after.get("effective_diameter"))
+        for axis, new in (after.get("position_deviation") or {}).items():
+            add(f"Position deviation {axis}", f"position_deviation.{axis}",
+                (before.get("position_deviation") or {}).get(axis), new)
+        return rows
+    for key, new in after.items():                       # _TP / _TPW faces
+        if isinstance(new, int | float):
+            add(f"Face {key}", key, before.get(key), new)
+    return rows
+
+
+def lathe_tool_info(env) -> dict | None:
+    """The tool in the turret as the screen shows it: T, type, SL, L1, L2, R (tool table, radius)."""
+    st = env.machine.status()
+    t = st.get("tool")
+    info = {"t": t, "lathe": True, "lengths": st.get("tool_lengths") or {}}
+    if t is None:
+        return info
+    try:
+        row = env.services.tools.get(t)
+    except Exception:
+        return info
+    wear = row.get("wear") or {}
+    info.update(type=row.get("type"), sl=row.get("sl"), l1=row.get("l1"), l2=row.get("l2"),
+                radius=float(row.get("radius") or 0.0) + float(wear.get("radius") or 0.0),
+                name=row.get("name"))
+    return info
+
+
+def _path_points(prep, start, tip) -> list[list[float]]:
+    """The planned NC reference points (MCS) of the program driven with ideal latches."""
+    pos = np.asarray(start, dtype=float)
+    points = []
+
+    def mcs(p, coords):
+        return tip.wcs2bcs.child2parent(p) if coords == "WCS" else np.asarray(p, dtype=float)
+
+    points.append([float(v) for v in mcs(pos, prep.coords)])
+    for step in lathe_planned_path(prep, start):
+        if isinstance(step, MoveStep):
+            pos = np.asarray(step.target, dtype=float)
+        elif isinstance(step, ProbeStep):
+            travel = step.expected if step.expected is not None else step.distance / 2.0
+            pos = pos + travel * np.asarray(step.direction, dtype=float)
+        else:
+            continue
+        points.append([float(v) for v in mcs(pos, prep.coords)])
+    return points
+
+
+def lathe_svgs(env, spec, params: dict | None, answer: dict | None) -> list:
+    """The real set-up with the planned path of the next NC Start (never breaks the screen)."""
+    try:
+        scene = env.machine.scene_geometry()
+        limits = env.machine.scenario.limits()
+    except Exception:
+        return []
+    path = None
+    if params is not None and not (answer or {}).get("result"):
+        try:
+            ctx = env.measuring_context()
+            normalised = spec.validate(params, ctx.plane)
+            plan_ctx = spec.plan_context(ctx, normalised)
+            prep = prepare(spec.name, normalised, plan_ctx)
+            tip = spec.tool_tip(ctx)
+            start = StepExecutor(env.machine.machine, ctx.chain().wcs2bcs, ctx.tool_length, ctx.plane.infeed_unit,
+                                 tip=tip).current(prep.coords)
+            path = _path_points(prep, start, tip)
+        except Exception:
+            path = None
+    focus = {"lathe.toolprobe.calibrate": ("tool_probe",), "lathe.tool.measure": ("tool_probe",),
+             "lathe.tool.auto": ("tool_probe",), "lathe.probe.groove": ("groove",)}.get(spec.name, ("part",))
+    return [Markup(lathe_svg(scene, limits, path=path, svg_id="task-lathe", focus=focus,
+                             caption="Real set-up, X up / Z right (MCS radius); dashed: the planned path"))]

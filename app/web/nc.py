@@ -1,0 +1,193 @@
+"""The MDA / AUTOMATIC screen and the program manager (design.md §9.4).
+
+MDA: an editor with line numbers, NC Start (the MCP key or the button: the form is the screen's
+``data-ncstart`` element), single block, NC Stop, Reset; the loaded program as a listing with
+the current block highlighted and an alarm shown at its line and column; the cycle results
+(``_OVR``/``_OVI``). The channel part is an htmx partial that polls while the program runs.
+With a program selected for AUTOMATIC the same screen shows that program (read-only: it is
+edited in the program manager).
+"""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+from fastapi import APIRouter, Form, Request
+
+from app.access.deps import needs
+from app.api.nc import authorizer
+from app.deps import NcDep, ProgramsDep
+from app.errors import HmiError
+from app.services.nc import MDA, NcSyntaxInput
+
+from .templating import render_block, render_screen, url_path
+
+router = APIRouter()
+
+
+def _listing(text: str, status: dict) -> list[dict]:
+    """The loaded program's lines: number, text, current, alarm (message and column)."""
+    block = status.get("block") or {}
+    alarm = status.get("alarm") or {}
+    current = block.get("line") if status.get("state") not in ("idle",) else None
+    rows = []
+    for n, line in enumerate(text.splitlines() or [""], start=1):
+        row = {"n": n, "text": line, "current": n == current, "alarm": None}
+        if alarm and alarm.get("line") == n:
+            row["alarm"] = {"message": alarm.get("message") or alarm.get("text"), "column": alarm.get("column"),
+                            "code": alarm.get("code")}
+        rows.append(row)
+    return rows
+
+
+def _results(nc) -> list[dict]:
+    """The non-zero _OVR/_OVI elements of the last cycle."""
+    values = nc.read_variables(["_OVR", "_OVI"])
+    out = [{"name": f"_OVR[{i}]", "value": f"{v:.4f}"} for i, v in enumerate(values["_OVR"]) if v]
+    out += [{"name": f"_OVI[{i}]", "value": str(v)} for i, v in enumerate(values["_OVI"]) if v]
+    return out
+
+
+def channel_context(nc, error: dict | None = None, text: str | None = None) -> dict:
+    status = nc.status()
+    if error is not None and text is not None:
+        loaded = text                       # the typed text with its error, not the program in the channel
+    else:
+        loaded = nc.loaded_text if status["program"] else (text if text is not None else nc.mda_text)
+    shown = {**status, "alarm": error, "block": None} if error else status
+    rows = _listing(loaded, shown)
+    if error:
+        status = {**status, "alarm": error}
+    return {"nc": status, "rows": rows, "results": _results(nc), "syntax_error": error,
+            "auto": status["program"] not in (None, MDA)}
+
+
+def _screen(request: Request, nc, error: dict | None = None, text: str | None = None, status_code: int = 200):
+    ctx = channel_context(nc, error, text)
+    editor = text if text is not None else nc.mda_text
+    return render_screen(request, "mda.html", {"screen": "mda", "editor": editor,
+                                               "lines": max(1, len(editor.splitlines()) + 1), **ctx},
+                         status_code=status_code)
+
+
+def _channel(request: Request, nc, error: dict | None = None, text: str | None = None, message: str = "",
+             level: str = "info"):
+    ctx = channel_context(nc, error, text)
+    return render_block(request, "mda.html", "channel", {**ctx, "message": message, "level": level})
+
+
+@router.get("/mda", name="mda_screen")
+def mda_screen(request: Request, nc: NcDep):
+    return _screen(request, nc)
+
+
+@router.get("/mda/channel", name="mda_channel")
+def mda_channel(request: Request, nc: NcDep):
+    return _channel(request, nc)
+
+
+@router.post("/mda/start", name="mda_start", dependencies=[needs("measure")])
+def mda_start(request: Request, nc: NcDep, text: Annotated[str, Form()] = "",
+              single_block: Annotated[str | None, Form()] = None):
+    """NC Start: the MDA text (loaded anew when it changed or the run has ended) or the program
+    selected for AUTOMATIC; single block as the toggle says."""
+    single = single_block is not None
+    status = nc.status()
+    try:
+        if status["program"] not in (None, MDA):
+            nc.start(wait=False, single_block=single, authorize=authorizer(request))
+        elif status["program"] == MDA and text == nc.mda_text and status["state"] in ("stopped", "ready"):
+            nc.start(wait=False, single_block=single, authorize=authorizer(request))
+        else:
+            nc.run(mda=text, wait=False, single_block=single, authorize=authorizer(request))
+    except NcSyntaxInput as exc:
+        nc.mda_text = text
+        return _channel(request, nc, error=exc.detail, text=text)
+    except HmiError as exc:
+        return _channel(request, nc, text=text, message=exc.message, level="error")
+    return _channel(request, nc)
+
+
+@router.post("/mda/stop", name="mda_stop", dependencies=[needs("jog")])
+def mda_stop(request: Request, nc: NcDep):
+    nc.stop()
+    return _channel(request, nc)
+
+
+@router.post("/mda/reset", name="mda_reset", dependencies=[needs("jog")])
+def mda_reset(request: Request, nc: NcDep):
+    try:
+        nc.reset()
+    except HmiError as exc:
+        return _channel(request, nc, message=exc.message, level="error")
+    return _channel(request, nc)
+
+
+@router.post("/mda/single-block", name="mda_single_block", dependencies=[needs("measure")])
+def mda_single_block(request: Request, nc: NcDep, single_block: Annotated[str | None, Form()] = None):
+    nc.set_single_block(single_block is not None)
+    return _channel(request, nc)
+
+
+# --- the program manager -----------------------------------------------------------------------------
+
+def _programs(request: Request, programs, nc, extra: dict | None = None, status_code: int = 200):
+    return render_screen(request, "programs.html", {"screen": "programs", "programs": programs.list(),
+                                                    "selected": nc.status()["program"], **(extra or {})},
+                         status_code=status_code)
+
+
+@router.get("/programs", name="programs_screen")
+def programs_screen(request: Request, programs: ProgramsDep, nc: NcDep):
+    return _programs(request, programs, nc)
+
+
+@router.post("/programs/new", name="programs_new", dependencies=[needs("measure")])
+def programs_new(request: Request, programs: ProgramsDep, nc: NcDep, name: Annotated[str, Form()] = ""):
+    try:
+        program = programs.create(name.strip(), "")
+    except HmiError as exc:
+        return _programs(request, programs, nc, {"new_error": exc.message, "new_text": name})
+    return _programs(request, programs, nc, {"editing": program})
+
+
+@router.get("/programs/{name}/edit", name="programs_edit")
+def programs_edit(request: Request, name: str, programs: ProgramsDep, nc: NcDep):
+    try:
+        program = programs.get(name)
+    except HmiError as exc:
+        return _programs(request, programs, nc, {"message": exc.message})
+    return _programs(request, programs, nc, {"editing": program})
+
+
+@router.post("/programs/{name}/save", name="programs_save", dependencies=[needs("measure")])
+def programs_save(request: Request, name: str, programs: ProgramsDep, nc: NcDep, text: Annotated[str, Form()] = ""):
+    try:
+        program, _ = programs.put(name, text)
+    except HmiError as exc:
+        return _programs(request, programs, nc, {"editing": {"name": name, "text": text, "syntax": None},
+                                                 "message": exc.message})
+    return _programs(request, programs, nc, {"editing": program, "saved": True})
+
+
+@router.post("/programs/{name}/delete", name="programs_delete", dependencies=[needs("measure")])
+def programs_delete(request: Request, name: str, programs: ProgramsDep, nc: NcDep):
+    try:
+        programs.delete(name)
+    except HmiError as exc:
+        return _programs(request, programs, nc, {"message": exc.message})
+    return _programs(request, programs, nc, {"message": f"Program {name} deleted"})
+
+
+@router.post("/programs/{name}/select", name="programs_select", dependencies=[needs("measure")])
+def programs_select(request: Request, name: str, programs: ProgramsDep, nc: NcDep):
+    """Select for AUTOMATIC: the program is loaded into the channel; the screen changes to it."""
+    try:
+        nc.select(name)
+    except NcSyntaxInput as exc:
+        return _programs(request, programs, nc, {"editing": programs.get(name), "message": exc.message})
+    except HmiError as exc:
+        return _programs(request, programs, nc, {"message": exc.message})
+    response = _screen(request, nc)
+    response.headers["HX-Push-Url"] = url_path(request, "mda_screen")
+    return response

@@ -1,0 +1,235 @@
+"""The 3D machine view's data (static/view3d.js draws it): everything in MCS, mm.
+
+- ``solids``: the true part and the fixtures (``app.services.trainer.visible_scene``: in trainer
+  mode only the fixtures);
+- ``probe``: where the NC puts the tool reference (the live position comes from ``/api/machine``,
+  the view adds ``probe.offset`` = true ball centre − NC position, zero in trainer mode);
+- ``wcs``: the active zero offset as a coordinate cross (where the HMI puts the part's zero);
+- ``plan``: the probing path of the open measurement's next point from where the probe stands
+  (before NC Start), as ``task_svg`` draws it in 2D;
+- ``touches``: the latched ball centres of the open measurement and of the last log entries;
+- ``measured``: what those log entries found (circles, rectangles, corner lines, edge faces): the
+  part as measured.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from app.services import trainer
+from app.services.measuring import MeasuringEnv
+from app.workflow import planning
+from app.workflow.executor import StepExecutor
+from app.workflow.tasks import TASKS
+from engine.frames import Frame, chain_of, is_basic
+from engine.plan import ideal_path
+from engine.planes import Plane
+from engine.types import MoveStep, ProbeStep
+
+LOG_ENTRIES = 3          # the last measurements drawn as touches and results
+AXES = ("X", "Y", "Z")
+
+
+def _vec(values) -> list[float]:
+    return [round(float(v), 4) for v in values]
+
+
+def _xyz(point: dict, fill: float = 0.0) -> np.ndarray:
+    return np.array([float(point.get(a, fill)) for a in AXES])
+
+
+def build(services) -> dict:
+    machine = services.machine
+    gud = services.settings.get()
+    hide = bool(gud.trainer_hide_part)
+    scene = trainer.visible_scene(services, hide)
+    status = machine.status()
+    nc = trainer.nc_tip(status)
+    probe = scene.get("probe") or {}
+    offset = np.asarray(probe.get("tip", nc), dtype=float) - np.asarray(nc)
+    limits = {a: list(v) for a, v in machine.scenario.limits().items() if a in AXES}
+    session = services.workflow.session if services.workflow is not None else None
+    plane = machine.plane()
+    return {
+        "hidden": hide,
+        "limits": limits,
+        "solids": {k: scene.get(k) for k in ("block", "prism", "circles", "rects", "spheres")},
+        "probe": {"tip": _vec(nc), "offset": _vec(offset), "diameter": float(probe.get("diameter", 0.0)),
+                  "is_probe": bool(probe.get("is_probe")), "axis": _vec(status.get("tool_axis") or (0, 0, 1)),
+                  "tool_length": float(status.get("tool_length") or 0.0)},
+        "wcs": _wcs(machine),
+        "plan": _plan(services, session),
+        "touches": _session_touches(session) + _log_touches(services),
+        "measured": _measured(services, plane),
+    }
+
+
+def _wcs(machine) -> dict | None:
+    name = machine.active_offset
+    if not name or name == "G500":
+        return None
+    frame = machine.chain.wcs2bcs
+    return {"name": name, "origin": _vec(frame.translation), "axes": [_vec(c) for c in frame.rotation.T]}
+
+
+# --- the open measurement ----------------------------------------------------------------------
+
+def _plan(services, session) -> dict | None:
+    """The next point's path from the probe's position (ideal latches: ``engine.plan.ideal_path``)."""
+    if session is None or session.running:
+        return None
+    n = session.next_point()
+    spec = TASKS.get(session.task)
+    if n is None or spec is None:
+        return None
+    try:
+        ctx = MeasuringEnv(services.db, services.machine, services.settings).measuring_context()
+        wcs2bcs = ctx.chain().wcs2bcs
+        executor = StepExecutor(services.machine.machine, wcs2bcs, ctx.tool_length, ctx.plane.infeed_unit)
+        start = np.asarray(executor.current(spec.coords))
+        steps = ideal_path(spec.program(session.params, n, start, planning.context_from(ctx)), start)
+    except Exception:          # a preview never breaks the view (the screen shows why NC Start refuses)
+        return None
+    to_mcs = wcs2bcs.child2parent if spec.coords == "WCS" else (lambda p: np.asarray(p, dtype=float))
+    segments, pos = [], start
+    for step in steps:
+        if isinstance(step, MoveStep):
+            target = np.asarray(step.target, dtype=float)
+            segments.append({"kind": "move", "from": _vec(to_mcs(pos)), "to": _vec(to_mcs(target))})
+            pos = target
+        elif isinstance(step, ProbeStep):
+            d = np.asarray(step.direction, dtype=float)
+            travel = step.expected if step.expected is not None else step.distance / 2.0
+            end = pos + travel * d
+            segments.append({"kind": "probe", "from": _vec(to_mcs(pos)), "to": _vec(to_mcs(end))})
+            pos = end
+    return {"task": session.task, "point": n, "segments": segments}
+
+
+def _session_touches(session) -> list[dict]:
+    if session is None:
+        return []
+    spec = TASKS.get(session.task)
+    out = []
+    for slot in session.slots:
+        if not slot.stored or slot.context is None:
+            continue
+        wcs2bcs = slot.context.chain().wcs2bcs
+        for latch in slot.raw:
+            at = latch.get("tip_mcs")
+            if at is None and latch.get("rec") is not None:
+                rec = np.asarray(latch["rec"], dtype=float)
+                at = wcs2bcs.child2parent(rec) if spec is None or spec.coords == "WCS" else rec
+            if latch.get("triggered") and at is not None:
+                out.append({"at": _vec(at), "label": f"P{slot.n}", "source": "session"})
+    return out
+
+
+# --- the log: the part as measured -------------------------------------------------------------
+
+def _recent(services) -> list[dict]:
+    try:
+        return [e for e in services.log.list(limit=LOG_ENTRIES) if e.get("status") == "ok"]
+    except Exception:
+        return []
+
+
+def _log_touches(services) -> list[dict]:
+    out = []
+    for entry in _recent(services):
+        for label, latches in (entry.get("raw") or {}).items():
+            for latch in latches or []:
+                if latch.get("triggered") and latch.get("tip_mcs"):
+                    out.append({"at": _vec(latch["tip_mcs"]), "label": label, "source": "log",
+                                "log_id": entry["id"], "task": entry["task"]})
+    return out
+
+
+def _entry_frame(entry: dict, frames: dict[str, Frame]) -> Frame | None:
+    """WCS -> BCS while the entry was measured: today's frames, with the corrected one as it was
+    before the correction (its ``before``), so the results land where they were measured."""
+    task = entry.get("task")
+    spec = TASKS.get(task) if isinstance(task, str) else None
+    if spec is None:
+        return None
+    if spec.coords != "WCS":
+        return Frame.identity()
+    wo = entry.get("measuring_wo") or "G500"
+    corr = entry.get("correction") or {}
+    target = corr.get("target")
+    if isinstance(target, str) and corr.get("before") and (target == wo or is_basic(target)):
+        try:
+            frames = {**frames, target: Frame.from_api(corr["before"])}
+        except Exception:
+            return None
+    try:
+        return chain_of(frames, wo).wcs2bcs
+    except Exception:
+        return None
+
+
+def _measured(services, plane: Plane) -> list[dict]:
+    try:
+        frames = services.machine.stored_frames()
+    except Exception:
+        return []
+    out = []
+    for entry in _recent(services):
+        frame = _entry_frame(entry, frames)
+        result = entry.get("result") or {}
+        if frame is None or not isinstance(result, dict):
+            continue
+        out += [{**shape, "log_id": entry["id"], "task": entry["task"]}
+                for shape in _shapes(result, frame, plane, _touch_height(entry, frame, plane))]
+    return out
+
+
+def _touch_height(entry: dict, frame: Frame, plane: Plane) -> float | None:
+    """The mean infeed coordinate (WCS of the measurement) of the entry's touches: where a result
+    without points (a hole's centre and diameter) is drawn."""
+    tips = [latch["tip_mcs"] for latches in (entry.get("raw") or {}).values() for latch in latches or []
+            if latch.get("triggered") and latch.get("tip_mcs")]
+    if not tips:
+        return None
+    mean = frame.parent2child(np.mean(np.asarray(tips, dtype=float), axis=0))
+    return float(mean[AXES.index(plane.infeed)])
+
+
+def _shapes(r: dict, frame: Frame, plane: Plane, touch_height: float | None = None) -> list[dict]:
+    """The result of one entry as 3D shapes (design.md §4 result keys, WCS of the measurement)."""
+    points = [p for p in r.get("points") or [] if isinstance(p, dict)]
+    if points:
+        height = float(np.mean([p.get(plane.infeed, 0.0) for p in points]))
+    else:
+        height = touch_height if touch_height is not None else 0.0
+    normal = _vec(frame.dir_child2parent(plane.infeed_unit))
+
+    def at(p: dict) -> list[float]:
+        q = _xyz({plane.infeed: height, **p})
+        return _vec(frame.child2parent(q))
+
+    def along(deg: float) -> list[float]:
+        c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+        return _vec(frame.dir_child2parent(c * plane.unit(plane.first) + s * plane.unit(plane.second)))
+
+    shapes: list[dict] = [{"kind": "point", "at": at(p)} for p in points]
+    centre = r.get("center")
+    if isinstance(r.get("corner"), dict):
+        angle = float(r.get("angle", 0.0))
+        second = float(r["angle_2"]) if "angle_2" in r else angle + 90.0
+        shapes.append({"kind": "corner", "at": at(r["corner"]), "dirs": [along(angle), along(second)]})
+    elif isinstance(centre, dict) and isinstance(r.get("diameter"), int | float):
+        shapes.append({"kind": "circle", "at": at(centre), "normal": normal, "diameter": float(r["diameter"])})
+    elif isinstance(centre, dict) and isinstance(r.get("length"), int | float) and isinstance(r.get("width"), int | float):
+        shapes.append({"kind": "rect", "at": at(centre), "normal": normal, "dirs": [along(0.0), along(90.0)],
+                       "size": [float(r["length"]), float(r["width"])]})
+    elif isinstance(r.get("position"), dict) and points:
+        for axis in r["position"]:
+            if axis in AXES:
+                shapes.append({"kind": "face", "at": at(points[0]),
+                               "normal": _vec(frame.dir_child2parent(np.eye(3)[AXES.index(axis)]))})
+    if isinstance(r.get("p1"), dict) and isinstance(r.get("p2"), dict):
+        shapes.append({"kind": "line", "from": at(r["p1"]), "to": at(r["p2"])})
+    return shapes

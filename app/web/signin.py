@@ -1,0 +1,67 @@
+"""Sign-in screen (design.md §9.2): user + password, or the operator panel (keyswitch level) on the
+machine's own computer; sign-out. A plain HTML form with the CSRF field, so it works without htmx."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+from fastapi import APIRouter, Form, Request, Response
+from fastapi.responses import RedirectResponse
+
+from app.access.deps import identity_of
+from app.access.levels import keyswitch_level
+from app.access.middleware import is_local
+from app.api.access import clear_session_cookie, set_session_cookie, sign_in
+from app.errors import HmiError
+
+from .templating import templates, url_path
+
+router = APIRouter()
+
+
+def _safe_next(request: Request, target: str | None) -> str:
+    """Only a path of this HMI (never another site, never //host)."""
+    if target and target.startswith("/") and not target.startswith("//") and "\\" not in target:
+        return target
+    return url_path(request, "jog_screen")
+
+
+def _page(request: Request, next_path: str, error: str = "", user: str = "", status_code: int = 200):
+    access = request.app.state.access
+    position = access.keyswitch()
+    return templates.TemplateResponse(request, "signin.html", {
+        "next": next_path, "error": error, "user": user, "identity": identity_of(request),
+        "signin_on": access.signin_on(), "panel_allowed": is_local(request.scope.get("client")),
+        "keyswitch": position, "keyswitch_level": keyswitch_level(position)},
+        status_code=status_code)
+
+
+@router.get("/signin", name="signin_screen")
+def signin_screen(request: Request, next: str | None = None):
+    return _page(request, _safe_next(request, next))
+
+
+@router.post("/signin", name="signin_submit")
+def signin_submit(request: Request, user: Annotated[str, Form()] = "", password: Annotated[str, Form()] = "",
+                  panel: Annotated[str, Form()] = "", next: Annotated[str, Form()] = ""):
+    target = _safe_next(request, next)
+    try:
+        secret, _identity = sign_in(request, user, password, panel == "1")
+    except HmiError as exc:
+        return _page(request, target, exc.message, user, status_code=exc.status)
+    response = RedirectResponse(target, status_code=303)
+    set_session_cookie(request, response, secret, request.app.state.access.session_seconds)
+    return response
+
+
+@router.post("/signout", name="signout_submit")
+def signout_submit(request: Request):
+    from app.access.service import SESSION_COOKIE
+
+    request.app.state.access.sign_out(request.cookies.get(SESSION_COOKIE))
+    if request.headers.get("HX-Request") == "true":        # htmx follows a 303 itself: tell it instead
+        response = Response(status_code=200, headers={"HX-Redirect": url_path(request, "signin_screen")})
+    else:
+        response = RedirectResponse(url_path(request, "signin_screen"), status_code=303)
+    clear_session_cookie(request, response)
+    return response
