@@ -152,6 +152,28 @@ def test_sign_in_sign_out_and_the_panels_disabled_softkeys(browser, signin_serve
         assert page.locator('#vsoftkeys [data-key="S-F1"]').is_disabled()
 
 
+def test_a_refused_write_says_why_on_the_message_line(browser, signin_server):
+    """The level can drop while a screen is open (signed out in another tab, key switch): a write
+    from a key still enabled is refused (403) and the message line says which level it needs."""
+    with browser_tab(browser, signin_server) as page:
+        page.goto("/signin")
+        page.click("#panel-submit")                                  # the operator panel, key at 0
+        page.wait_for_url("**/jog")
+        page.goto("/offsets")
+        cell = page.locator('td[data-offset="G57"][data-field="trans.Y"] input')
+        assert cell.is_disabled()
+        # the request a screen rendered before the level dropped sends
+        with page.expect_response(lambda r: "/offsets/G57/trans.Y" in r.url) as answer:
+            page.evaluate("""() => htmx.ajax("POST", "/offsets/G57/trans.Y",
+                {target: 'td[data-offset="G57"][data-field="trans.Y"]', swap: "outerHTML", values: {value: "7.5"}})""")
+        assert answer.value.status == 403
+        expect(page.locator("#message")).to_contain_text("level 5")
+        expect(page.locator("#message")).to_have_class(re.compile(r"\berror\b"))
+        assert page.locator("#screen").count() == 1                  # the screen itself stays
+        page.reload()
+        expect(page.locator('td[data-offset="G57"][data-field="trans.Y"] input')).not_to_have_value("7.5")
+
+
 def test_docs_work_offline_and_try_it_out_respects_the_levels(browser, live_server):
     with browser_tab(browser, live_server, timeout_ms=15000) as page:
         outside: list[str] = []

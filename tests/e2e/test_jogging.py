@@ -102,6 +102,27 @@ def test_rapid_runs_at_rapid_traverse_times_the_rapid_override(browser, live_ser
         expect(page.locator("#rapid-override")).to_have_value("25")
 
 
+def test_a_key_swapped_in_works_at_once(page):
+    """A panel answer swaps in new keys; a key pressed right after (here in the same moment the
+    answer is in) must act. htmx attaches a key's handlers when it settles; with its default 20 ms
+    settle delay such a press did nothing (CI: RAPID pressed right after the rapid override)."""
+    page.goto("/jog")
+    expect(page.locator("#rapid")).to_have_attribute("aria-pressed", "false")
+    page.evaluate("""() => new Promise(resolve => {
+        document.addEventListener("htmx:afterRequest", () => {     // the answer is swapped in:
+            document.getElementById("rapid").click();             // the new key, at once
+            resolve();
+        }, {once: true});
+        const override = document.getElementById("rapid-override");
+        override.value = "50";
+        override.dispatchEvent(new Event("change", {bubbles: true}));
+    })""")
+    expect(page.locator("#mcp")).to_have_attribute("data-rov", "50")
+    expect(page.locator("#rapid")).to_have_attribute("aria-pressed", "true")
+    page.locator("#rapid").click()                             # leave RAPID off for the next tests
+    expect(page.locator("#rapid")).to_have_attribute("aria-pressed", "false")
+
+
 def test_keyboard_jog_runs_while_the_key_is_held(browser, live_server, api):
     real_time(api)
     with browser_tab(browser, live_server) as page:
