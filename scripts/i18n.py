@@ -49,7 +49,8 @@ def _field_texts(path: Path):
                 yield arg.lineno, arg.value
 
 
-def extract() -> Catalog:
+def collect() -> Catalog:
+    """Every text the screens show, from the code, the templates and the data tables."""
     catalog = Catalog(project="Measure-in-JOG HMI", charset="utf-8")
     for filename, lineno, message, comments, _context in extract_from_dir(
             str(ROOT), METHODS, keywords=KEYWORDS, options_map=OPTIONS, strip_comment_tags=True):
@@ -71,6 +72,11 @@ def extract() -> Catalog:
         for lineno, text in _field_texts(ROOT / rel):
             if not text.isdigit() and text not in ("+", "-", "−"):
                 catalog.add(text, locations=[(rel, lineno)])
+    return catalog
+
+
+def extract() -> Catalog:
+    catalog = collect()
     LOCALE.mkdir(parents=True, exist_ok=True)
     with POT.open("wb") as fp:
         write_po(fp, catalog, width=100, sort_by_file=False)
