@@ -33,13 +33,36 @@
     if (chosen.rapid) headers["X-Panel-Rapid"] = chosen.rapid;
     if (chosen.rov) headers["X-Panel-Rov"] = chosen.rov;
   });
+  function differs(panel, withKeys) {      // the panel shows other choices than the tab holds
+    var keys = {};                          // hmi.js's: axis and increment
+    if (withKeys) try { keys = JSON.parse(sessionStorage.getItem("hmi-panel")) || {}; } catch (e) { /* private mode */ }
+    return (keys.axis && keys.axis !== panel.dataset.axis) || (keys.increment && keys.increment !== panel.dataset.increment) ||
+           (chosen.feed !== undefined && chosen.feed !== panel.dataset.jogFeed) ||
+           (chosen.rapid && chosen.rapid !== panel.dataset.rapid) || (chosen.rov && chosen.rov !== panel.dataset.rov);
+  }
+  function redraw(panel) { htmx.ajax("POST", panel.dataset.jogFeedUrl, { target: "#mcp", swap: "outerHTML", values: {} }); }
   document.addEventListener("DOMContentLoaded", function () {     // a page load renders the defaults
     var panel = mcp();
-    if (!panel) return;
-    if ((chosen.feed !== undefined && chosen.feed !== panel.dataset.jogFeed) ||
-        (chosen.rapid && chosen.rapid !== panel.dataset.rapid) || (chosen.rov && chosen.rov !== panel.dataset.rov)) {
-      htmx.ajax("POST", panel.dataset.jogFeedUrl, { target: "#mcp", swap: "outerHTML", values: {} });
-    }
+    if (panel && differs(panel, false)) redraw(panel);         // axis and increment: hmi.js restorePanel
+  });
+  // Panel answers can overtake each other or land on a panel already replaced (a key pressed
+  // while the previous answer was on its way): once none is on its way, the panel must show what
+  // the tab holds, else it is drawn once more (the choices travel as headers, so that answer is right).
+  // loadend of the request itself: htmx's own events do not reach the page from a replaced panel.
+  var panelRequests = 0, redraws = 0;
+  document.addEventListener("htmx:beforeRequest", function (event) {
+    var target = event.detail.target;
+    if (!target || target.id !== "mcp") return;
+    panelRequests++;
+    event.detail.xhr.addEventListener("loadend", function () {
+      panelRequests--;
+      setTimeout(function () {
+        var panel = mcp();
+        if (!panel || panelRequests > 0) return;
+        if (!differs(panel, true)) { redraws = 0; return; }
+        if (redraws < 3) { redraws++; redraw(panel); }           // never a loop on a refused value
+      }, 0);
+    });
   });
 
   // --- keyboard jog, hold-to-run: the arrow keys move X and Y, Page Up/Down Z, Shift = rapid.

@@ -123,6 +123,30 @@ def test_a_key_swapped_in_works_at_once(page):
     expect(page.locator("#rapid")).to_have_attribute("aria-pressed", "false")
 
 
+def test_rapid_pressed_while_the_panel_loads_is_not_lost(browser, live_server):
+    """RAPID pressed while the rapid override's answer is on its way (CI: the key looked dead). The
+    override's answer replaces the panel; RAPID's answer then belongs to a panel no longer shown."""
+    with browser_tab(browser, live_server) as page:
+        page.goto("/jog")
+        held = []
+        page.route("**/ui/panel/jogfeed", lambda route: held.append(route))
+        page.locator("#rapid-override").select_option("50")
+        page.locator("#rapid").click()                              # pressed meanwhile
+        for _ in range(50):
+            if len(held) == 2:
+                break
+            page.wait_for_timeout(100)
+        assert len(held) == 2
+        held[0].continue_()                                         # the override's answer first
+        expect(page.locator("#mcp")).to_have_attribute("data-rov", "50")
+        held[1].continue_()                                         # then RAPID's
+        page.unroute("**/ui/panel/jogfeed")
+        expect(page.locator("#rapid")).to_have_attribute("aria-pressed", "true")
+        expect(page.locator("#rapid-override")).to_have_value("50")
+        page.locator("#rapid").click()                              # RAPID off again for the next tests
+        expect(page.locator("#rapid")).to_have_attribute("aria-pressed", "false")
+
+
 def test_keyboard_jog_runs_while_the_key_is_held(browser, live_server, api):
     real_time(api)
     with browser_tab(browser, live_server) as page:
