@@ -87,19 +87,19 @@ def test_rapid_runs_at_rapid_traverse_times_the_rapid_override(browser, live_ser
         expect(page.locator("#mcp")).to_have_attribute("data-axis", "X")
         page.locator('#mcp button[data-increment="cont"]').click()
         expect(page.locator("#mcp")).to_have_attribute("data-increment", "cont")
-        page.locator("#rapid-override").select_option("25")
-        expect(page.locator("#mcp")).to_have_attribute("data-rov", "25")
+        page.locator("#rapid-override").select_option("50")            # not the default (25 %)
+        expect(page.locator("#mcp")).to_have_attribute("data-rov", "50")
         page.locator("#rapid").click()
         expect(page.locator("#rapid")).to_have_attribute("aria-pressed", "true")
         hold_jog_key(page)
         time.sleep(0.3)
         speed = speed_while(api, "X")
         page.mouse.up()
-        assert speed == pytest.approx(RAPID * 0.25, rel=0.3)
+        assert speed == pytest.approx(RAPID * 0.5, rel=0.3)
         assert settle(api)["busy"] is False
         page.reload()
         expect(page.locator("#rapid")).to_have_attribute("aria-pressed", "true")
-        expect(page.locator("#rapid-override")).to_have_value("25")
+        expect(page.locator("#rapid-override")).to_have_value("50")
 
 
 def test_a_key_swapped_in_works_at_once(page):
