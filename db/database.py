@@ -67,7 +67,7 @@ class Database:
         self.path = Path(path)
         self._layout = offset_layout(extra_settable, basic_frames)
         self._generation = 0                   # committed write units so far (see ``generation``)
-        self._generation_lock = threading.Lock()
+        self._write_turn = threading.RLock()   # held by this process's writing unit
         self._rotary_axes = tuple(rotary_axes)
         # check_same_thread off: the pool hands connections to FastAPI's worker threads.
         self._engine = create_engine(f"sqlite:///{self.path}", connect_args={"check_same_thread": False})
@@ -96,6 +96,12 @@ class Database:
                 finally:
                     unit.detach()
             return
+        # This process's writers take turns from BEGIN until the count is raised after the
+        # commit: a writer never sees a committed change not yet counted, and a reader that
+        # read the count before a commit sees it raised afterwards (see ``generation``).
+        if not self._write_turn.acquire(timeout=BUSY_TIMEOUT_MS / 1000):
+            raise StorageUnavailable(f"the database {self.path} cannot be written: another write "
+                                     f"did not end within {BUSY_TIMEOUT_MS // 1000} s")
         try:
             with Session(self._write_engine, expire_on_commit=False) as session, session.begin():
                 unit = Unit(session, self._layout)
@@ -103,15 +109,17 @@ class Database:
                     yield unit
                 finally:
                     unit.detach()
-                with self._generation_lock:    # before the commit: a reader holding the write
-                    self._generation += 1      # lock never sees a committed change as not made
+            self._generation += 1
         except OperationalError as exc:      # disk full, read-only file, I/O error: rolled back
             raise StorageUnavailable(f"the database {self.path} cannot be written: {_cause(exc)}") from exc
+        finally:
+            self._write_turn.release()
 
     @property
     def generation(self) -> int:
-        """Counts this process's committed writes: a value read while it stays the same is still
-        the stored one (this process is the database's only writer), so it may be cached."""
+        """Counts this process's committed writes, raised after each commit: what a reader reads
+        after reading the count is still the stored value while the count stays the same (this
+        process is the database's only writer), so it may be cached under the count read."""
         return self._generation
 
     def offset_names(self) -> list[str]:

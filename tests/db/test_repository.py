@@ -4,11 +4,13 @@ import math
 import sqlite3
 import subprocess
 import sys
+import threading
 from datetime import UTC, datetime, timedelta
 
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from sqlalchemy import event
 
 from db import Database
 
@@ -245,3 +247,42 @@ def test_log_keeps_the_measuring_wo_and_warnings_as_their_own_fields(tmp_path):
             entry = unit.get_log(log_id)
     assert entry["measuring_wo"] == "G500" and entry["warnings"] == ["Probe not calibrated"]
     assert entry["params"] == {"axis": "X"}          # nothing smuggled into the params any more
+
+
+def test_a_value_read_while_a_write_commits_is_not_cached_as_the_stored_one(db):
+    """The generation contract the caches rely on: a reader reads the count, then the value.
+    While the count stays the same the value must be the stored one; a reader that came in
+    between another writer's last statement and its commit read the old value, so the count
+    must move on afterwards (it was raised before the commit: the MTConnect table and the
+    frame caches kept the old G54 until the next write)."""
+    seen: dict[str, object] = {}
+
+    def read_meanwhile(_connection) -> None:
+        if seen:
+            return
+        seen["generation"] = db.generation
+        with db.unit(readonly=True) as unit:
+            seen["x"] = unit.get_offset("G54")["trans"]["X"]
+
+    event.listen(db.engine, "commit", read_meanwhile)     # fires just before the commit
+    try:
+        with db.unit() as unit:
+            unit.put_offset("G54", {"trans": {"X": 12.5}}, source="test")
+    finally:
+        event.remove(db.engine, "commit", read_meanwhile)
+    assert seen["x"] == 0.0                                # the old value, read mid-commit
+    assert db.generation != seen["generation"], "the old value would be taken for the stored one"
+
+
+def test_writers_of_one_process_take_turns_and_each_counts(db):
+    def write(x: float) -> None:
+        with db.unit() as unit:
+            unit.put_offset("G55", {"trans": {"X": x}}, source="test")
+
+    before = db.generation
+    threads = [threading.Thread(target=write, args=(float(i),)) for i in range(8)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert db.generation == before + 8
