@@ -12,6 +12,7 @@
   var lastSeen = Date.now();
   var machineSig = null;
   var sessionSig = null;
+  var lastSession = null;       // the newest session event's signature (sessionSig: the one last asked for)
   var quiet = false;
 
   function connection(ok) {
@@ -49,6 +50,12 @@
     return now;
   }
 
+  // an answer the browser gave up on (htmx's timeout, a send error) drew nothing: the next event
+  // asks again, since a state that no longer changes would never ask (e.g. a measurement's outcome)
+  ["htmx:timeout", "htmx:sendError"].forEach(function (name) {
+    document.addEventListener(name, function () { machineSig = sessionSig = null; });
+  });
+
   var source = new EventSource(url);
   source.addEventListener("open", function () { seen(); });
   source.addEventListener("machine", function (event) {
@@ -57,12 +64,13 @@
     showPositions(state);
     var sig = machineSignature(state);
     machineSig = changed(machineSig, sig, "hmi-state");
+    if (sessionSig === null && lastSession !== null) sessionSig = changed(null, lastSession, "hmi-session");
   });
   source.addEventListener("session", function (event) {
     seen();
-    var sig = sessionSignature(JSON.parse(event.data));
-    sessionSig = changed(sessionSig, sig, "hmi-session");
+    lastSession = sessionSignature(JSON.parse(event.data));
+    sessionSig = changed(sessionSig, lastSession, "hmi-session");
   });
-  source.addEventListener("error", function () { machineSig = sessionSig = null; });
+  source.addEventListener("error", function () { machineSig = sessionSig = lastSession = null; });
   window.addEventListener("pagehide", function () { source.close(); });
 })();

@@ -115,3 +115,37 @@ def test_a_running_measurement_shows_point_and_step(browser, live_server, api):
         seen.discard("")
         assert len(seen) >= 3, f"the steps shown while measuring: {sorted(seen)}"
         expect(page.locator("#task-result")).to_be_visible(timeout=30000)
+
+
+def test_the_outcome_shows_although_a_progress_answer_came_too_late(browser, live_server, api):
+    """The screen asks for its progress on each session event. When the answer that holds the
+    outcome is so late that the browser gives up on it (a busy computer), the outcome must still
+    show: after the measurement no session event follows that would ask again."""
+    real_time(api, time_scale=0.2)
+    cx, cy, top = TEST_SCENARIO["ring_gauge"]["center"]
+    for body in ({"Z": -100.0}, {"X": cx + 0.2, "Y": cy - 0.1}, {"Z": top - 8.0}):     # G500: WCS = tip
+        assert api.post("/api/machine/goto", json={**body, "coords": "WCS"}).status_code == 200
+    with browser_tab(browser, live_server, timeout_ms=8000) as page, stopped_afterwards(api):
+        page.goto("/measure/workpiece/calibrate/radius")
+        page.evaluate("() => { window.givenUp = 0; document.addEventListener('htmx:timeout', () => window.givenUp++); }")
+        field = page.locator('input[name="diameter"]')
+        field.fill(str(TEST_SCENARIO["ring_gauge"]["diameter"]))
+        field.dispatch_event("change")
+        held = []
+
+        def hold_the_outcome(route) -> None:      # answers with the outcome never arrive, until one was given up
+            answer = route.fetch()
+            if 'id="task-result"' in answer.text() and not page_gave_up:
+                held.append(route)
+            else:
+                route.fulfill(response=answer)
+
+        page_gave_up = False
+        page.route("**/progress*", hold_the_outcome)
+        page.locator("#nc-start").click()
+        expect(page.locator("#task-progress")).to_contain_text("Measuring P1")
+        page.wait_for_function("() => window.givenUp > 0", timeout=60000)
+        page_gave_up = True
+        assert held, "no answer with the outcome was held back: the test proved nothing"
+        expect(page.locator("#task-result")).to_be_visible(timeout=10000)
+        page.unroute("**/progress*")
