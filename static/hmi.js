@@ -107,6 +107,30 @@
     } catch (e) { /* an HTML answer swaps itself */ }
   });
 
+  // --- answers for the screen (#screen) are drawn in the order they were asked for. Two on their
+  // way at once were both aimed at the screen as it was: the second to arrive would be drawn into
+  // the screen the first replaced, i.e. nowhere (NC Start right after a new target: the outcome
+  // was lost). So it goes to the screen shown now, unless a later-asked answer was drawn already.
+  // htmx tells of a swap on its target, which may be out of the page by then: the guard listens there
+  var screenAsked = 0, screenDrawn = 0;
+  function drawInOrder(event) {
+    var ask = event.detail.xhr && event.detail.xhr.hmiScreenAsk;
+    if (!ask || !event.detail.shouldSwap) return;
+    if (ask < screenDrawn) { event.detail.shouldSwap = false; return; }     // outdated
+    screenDrawn = ask;
+    var shown = document.getElementById("screen");
+    if (shown && !document.body.contains(event.detail.target)) event.detail.target = shown;
+  }
+  document.addEventListener("htmx:beforeRequest", function (event) {
+    var target = event.detail.target;
+    if (!target || target.id !== "screen") return;
+    event.detail.xhr.hmiScreenAsk = ++screenAsked;
+    if (!target.hmiDrawsInOrder) {
+      target.hmiDrawsInOrder = true;
+      target.addEventListener("htmx:beforeSwap", drawInOrder);
+    }
+  });
+
   // --- a new correction target re-renders the measuring screen, and a set-up support answer its
   // screen, with the form as it was sent: what the operator typed or chose while that answer was
   // on its way is put back (nothing typed is lost); on set-up support it is then sent again, since

@@ -210,6 +210,45 @@ def test_what_is_typed_while_a_new_target_loads_is_kept(tab, station):
         tab.unroute("**/refresh")
 
 
+def test_nc_start_right_after_a_new_target_shows_the_outcome(tab, station):
+    """The target chosen, then NC Start at once, both answers on their way (a busy computer): the
+    target's answer arrives first and replaces the screen NC Start was pressed on; NC Start's
+    answer must still show (CI: the input screen stayed, "Measurement done" above it, no result)."""
+    open_screen(tab, station, "parallel", "/measure/workpiece/edge/set")
+    fill(tab, axis="X", direction="+", setpoint="0")
+    station.ball_to(part_to_mcs("parallel", -12, 100, -20))
+    held: dict = {}
+
+    def hold(name):          # the server answers at once; the browser gets the answer when released
+        return lambda route: held.setdefault(name, (route, route.fetch()))
+
+    def wait_for(name) -> None:
+        for _ in range(50):
+            if name in held:
+                return
+            tab.wait_for_timeout(100)
+        raise AssertionError(f"no {name} request")
+
+    tab.route("**/refresh", hold("target"))
+    tab.route("**/start", hold("start"))
+    try:
+        tab.locator('#task-form select[name="target"]').select_option("G54")
+        wait_for("target")
+        tab.locator("#nc-start").click()
+        wait_for("start")
+        for name, url in (("target", "**/refresh"), ("start", "**/start")):     # in this order
+            route, answer = held[name]
+            with tab.expect_response(url):
+                route.fulfill(response=answer)
+        expect(tab.locator("#task-result")).to_be_visible()
+        expect(tab.locator("#task-result .activation")).to_contain_text("activated")
+        expect(tab.locator('#task-form select[name="target"]')).to_have_value("G54")
+    finally:
+        tab.unroute("**/refresh")
+        tab.unroute("**/start")
+    assert station.g54()["trans"]["X"] == pytest.approx(part_to_mcs("parallel", 0, 0)[0], abs=1e-6)
+
+
 def test_distance_two_edges_y(tab, station):
     open_screen(tab, station, "parallel", "/measure/workpiece/edge/distance")
     fill(tab, axis="Y", direction="+", direction_p2="-", setpoint="5")
