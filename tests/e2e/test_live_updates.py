@@ -35,6 +35,21 @@ def stopped_afterwards(api):
             time.sleep(0.05)
 
 
+def probe_in_the_ring(api) -> None:
+    """At a fifth of real time (a ring calibration then takes ~40 s), the probe in the ring gauge."""
+    real_time(api, time_scale=0.2)
+    cx, cy, top = TEST_SCENARIO["ring_gauge"]["center"]
+    for body in ({"Z": -100.0}, {"X": cx + 0.2, "Y": cy - 0.1}, {"Z": top - 8.0}):     # G500: WCS = tip
+        assert api.post("/api/machine/goto", json={**body, "coords": "WCS"}).status_code == 200
+
+
+def open_ring_calibration(page) -> None:
+    page.goto("/measure/workpiece/calibrate/radius")
+    field = page.locator('input[name="diameter"]')
+    field.fill(str(TEST_SCENARIO["ring_gauge"]["diameter"]))
+    field.dispatch_event("change")
+
+
 def test_positions_follow_a_move_without_polling(browser, live_server, api):
     real_time(api)
     with browser_tab(browser, live_server) as page:
@@ -90,15 +105,9 @@ def test_header_and_alarm_pane_agree_and_show_the_remedy(browser, live_server, a
 def test_a_running_measurement_shows_point_and_step(browser, live_server, api):
     """A ring-gauge radius calibration at a fifth of real time (real: ~40 s): the screen counts its
     steps while it runs."""
-    real_time(api, time_scale=0.2)
-    cx, cy, top = TEST_SCENARIO["ring_gauge"]["center"]
-    for body in ({"Z": -100.0}, {"X": cx + 0.2, "Y": cy - 0.1}, {"Z": top - 8.0}):     # G500: WCS = tip
-        assert api.post("/api/machine/goto", json={**body, "coords": "WCS"}).status_code == 200
+    probe_in_the_ring(api)
     with browser_tab(browser, live_server, timeout_ms=8000) as page, stopped_afterwards(api):
-        page.goto("/measure/workpiece/calibrate/radius")
-        field = page.locator('input[name="diameter"]')
-        field.fill(str(TEST_SCENARIO["ring_gauge"]["diameter"]))
-        field.dispatch_event("change")
+        open_ring_calibration(page)
         page.locator("#nc-start").click()
         progress = page.locator("#task-progress")
         expect(progress).to_contain_text("Measuring P1")
@@ -121,16 +130,10 @@ def test_the_outcome_shows_although_a_progress_answer_came_too_late(browser, liv
     """The screen asks for its progress on each session event. When the answer that holds the
     outcome is so late that the browser gives up on it (a busy computer), the outcome must still
     show: after the measurement no session event follows that would ask again."""
-    real_time(api, time_scale=0.2)
-    cx, cy, top = TEST_SCENARIO["ring_gauge"]["center"]
-    for body in ({"Z": -100.0}, {"X": cx + 0.2, "Y": cy - 0.1}, {"Z": top - 8.0}):     # G500: WCS = tip
-        assert api.post("/api/machine/goto", json={**body, "coords": "WCS"}).status_code == 200
+    probe_in_the_ring(api)
     with browser_tab(browser, live_server, timeout_ms=8000) as page, stopped_afterwards(api):
-        page.goto("/measure/workpiece/calibrate/radius")
+        open_ring_calibration(page)
         page.evaluate("() => { window.givenUp = 0; document.addEventListener('htmx:timeout', () => window.givenUp++); }")
-        field = page.locator('input[name="diameter"]')
-        field.fill(str(TEST_SCENARIO["ring_gauge"]["diameter"]))
-        field.dispatch_event("change")
         held = []
 
         def hold_the_outcome(route) -> None:      # answers with the outcome never arrive, until one was given up
