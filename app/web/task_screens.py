@@ -308,6 +308,11 @@ def _screen_context(env: _Env, page: TaskPage, form: dict | None, *, answer=None
                     notice: str = "") -> dict:
     task = page.task
     fields, session, data = _typed(env, task, form)
+    # running before the outcome: NC Start's thread sets the outcome, then ends running. Read the
+    # other way round, a measurement ending meanwhile showed neither its progress nor its outcome,
+    # and no later session event would ask again
+    running = bool(session is not None and session.running)
+    progress = (session.progress if session is not None else None) or {}
     stored_any = _stored_any(session)
     spec = task_spec(task)
     n_points = spec.points
@@ -358,8 +363,8 @@ def _screen_context(env: _Env, page: TaskPage, form: dict | None, *, answer=None
         "tool_mode": data.values.get("target") == TOOL_TARGET,
         "decision": _decision(answer),
         "decision_alarm": ((answer or {}).get("result") or {}).get("alarm"),
-        "running": bool(session is not None and session.running),
-        "progress": (session.progress if session is not None else None) or {},
+        "running": running,
+        "progress": progress,
         **task_help.context(env.services, task, data.values),      # help picture, equipment (issue 17 item 5)
     }
 

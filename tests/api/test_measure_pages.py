@@ -96,6 +96,38 @@ def test_one_hole_through_the_screen_writes_g54_and_the_log(client):
     assert detail.status_code == 200 and 'class="log-detail"' in detail.text
 
 
+def test_a_measurement_ending_while_its_screen_is_drawn_shows_progress_or_outcome(client):
+    """NC Start's thread sets the outcome, then ends ``running``; the screen is drawn meanwhile in
+    another thread. Whatever moment the thread ends at, the screen shows the progress (which asks
+    again at the next session event) or the outcome: drawn with neither, nothing asks again."""
+    client.post("/api/machine/tool", json={"tool": 9})
+    _ball_to(client, HOLE_MCS[0] + 1.0, HOLE_MCS[1] - 2.0, BLOCK_TOP_Z - 10.0)
+    form = {"target": "measure_only", "diameter": "20", "probe_angle": "0", "setpoint.X": "0", "setpoint.Y": "0"}
+    assert 'id="task-result"' in client.post("/measure/task/hole.1/start", headers=HTMX, data=form).text
+    session = client.app.state.services.workflow.session
+    outcome = session.last
+
+    class EndsWhenTheOutcomeIsRead(type(session)):
+        """The thread ends right after the screen has read the outcome (still the old one)."""
+        @property
+        def last(self):
+            shown = self.__dict__["last"]
+            if self.__dict__.pop("ends_now", False):
+                self.__dict__["last"], self.running = outcome, False
+            return shown
+
+        @last.setter
+        def last(self, value):
+            self.__dict__["last"] = value
+
+    session.__class__ = EndsWhenTheOutcomeIsRead
+    session.__dict__.update(last=None, ends_now=True)
+    session.running = True
+    screen = client.get("/measure/task/hole.1/progress?n=1", headers=HTMX).text
+    assert not session.running and session.__dict__["last"] is outcome        # it did end meanwhile
+    assert 'id="task-progress"' in screen or 'id="task-result"' in screen
+
+
 def test_alarm_shows_on_the_screen_and_nothing_is_stored(client):
     client.post("/api/machine/tool", json={"tool": 9})
     _ball_to(client, 100.0, 100.0, BLOCK_TOP_Z - 10.0)     # in front of the block: -Y probes into nothing
