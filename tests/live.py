@@ -14,6 +14,16 @@ CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic"
                  "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 
 
+def wait_for_requests(page, held, count: int = 1, timeout_s: float = 5.0) -> None:
+    """Until a route handler has held ``count`` requests (``held``: its list or dict). Waits with
+    the page's own timer, so that Playwright runs the route handlers meanwhile."""
+    for _ in range(int(timeout_s * 10)):
+        if len(held) >= count:
+            return
+        page.wait_for_timeout(100)
+    raise AssertionError(f"{len(held)} of {count} requests held within {timeout_s} s")
+
+
 @contextmanager
 def browser_tab(browser, base_url: str, width: int = 1280, height: int = 720, timeout_ms: int = 5000):
     """A page in a fresh browser context on ``base_url``; the context is closed afterwards."""

@@ -12,7 +12,7 @@ import time
 
 import pytest
 from hmi_testdata import test_scenario
-from live import browser_tab
+from live import browser_tab, wait_for_requests
 from playwright.sync_api import expect
 
 pytestmark = pytest.mark.e2e
@@ -99,10 +99,7 @@ def test_a_panel_key_pressed_while_the_panel_loads_is_not_lost(browser, live_ser
         held = []
         page.route("**/ui/panel/axis", lambda route: held.append(route))      # a slow answer
         page.locator('#mcp button[data-axis="Y"]').click()
-        for _ in range(50):
-            if held:
-                break
-            page.wait_for_timeout(100)
+        wait_for_requests(page, held)
         assert len(held) == 1
         page.locator('#mcp button[data-increment="cont"]').click()            # pressed meanwhile
         held.pop().continue_()

@@ -12,7 +12,7 @@ import time
 import numpy as np
 import pytest
 from hmi_testdata import TEST_SCENARIO, test_scenario
-from live import browser_tab
+from live import browser_tab, wait_for_requests
 from playwright.sync_api import expect
 
 pytestmark = pytest.mark.e2e
@@ -132,10 +132,7 @@ def test_rapid_pressed_while_the_panel_loads_is_not_lost(browser, live_server):
         page.route("**/ui/panel/jogfeed", lambda route: held.append(route))
         page.locator("#rapid-override").select_option("50")
         page.locator("#rapid").click()                              # pressed meanwhile
-        for _ in range(50):
-            if len(held) == 2:
-                break
-            page.wait_for_timeout(100)
+        wait_for_requests(page, held, 2)
         assert len(held) == 2
         held[0].continue_()                                         # the override's answer first
         expect(page.locator("#mcp")).to_have_attribute("data-rov", "50")

@@ -14,7 +14,7 @@ import httpx
 import numpy as np
 import pytest
 from hmi_testdata import PROBE_LENGTH, test_scenario
-from live import browser_tab
+from live import browser_tab, wait_for_requests
 from playwright.sync_api import expect
 
 pytestmark = pytest.mark.e2e
@@ -193,10 +193,7 @@ def test_what_is_typed_while_a_new_target_loads_is_kept(tab, station):
     tab.route("**/refresh", lambda route: held.append(route))      # the new target's answer is late
     try:
         tab.locator('#task-form select[name="target"]').select_option("G54")
-        for _ in range(50):
-            if held:
-                break
-            tab.wait_for_timeout(100)
+        wait_for_requests(tab, held)
         assert len(held) == 1
         fill(tab, axis="Y", setpoint="12.5")                         # typed while it is on its way
         tab.evaluate("document.getElementById('task-form').dataset.stale = '1'")
@@ -222,20 +219,13 @@ def test_nc_start_right_after_a_new_target_shows_the_outcome(tab, station):
     def hold(name):          # the server answers at once; the browser gets the answer when released
         return lambda route: held.setdefault(name, (route, route.fetch()))
 
-    def wait_for(name) -> None:
-        for _ in range(50):
-            if name in held:
-                return
-            tab.wait_for_timeout(100)
-        raise AssertionError(f"no {name} request")
-
     tab.route("**/refresh", hold("target"))
     tab.route("**/start", hold("start"))
     try:
         tab.locator('#task-form select[name="target"]').select_option("G54")
-        wait_for("target")
+        wait_for_requests(tab, held)
         tab.locator("#nc-start").click()
-        wait_for("start")
+        wait_for_requests(tab, held, 2)
         for name, url in (("target", "**/refresh"), ("start", "**/start")):     # in this order
             route, answer = held[name]
             with tab.expect_response(url):

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from live import browser_tab, serve
+from live import browser_tab, serve, wait_for_requests
 from playwright.sync_api import expect
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "flows"))
@@ -72,10 +72,7 @@ def test_example2_orient_plane_with_swivel(tab, http):
     held = []                       # the first answer is late: the second choice is made meanwhile
     tab.route("**/toggle", lambda route: held.append(route))
     tab.locator('[data-toggle="retract"] select').select_option("no")
-    for _ in range(50):
-        if held:
-            break
-        tab.wait_for_timeout(100)
+    wait_for_requests(tab, held)
     tab.locator('[data-toggle="realign"] select').select_option("yes")
     tab.wait_for_timeout(300)
     for route in list(held):
