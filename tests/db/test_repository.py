@@ -11,6 +11,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from sqlalchemy import event
+from sqlalchemy.orm import Session
 
 from db import Database
 
@@ -274,15 +275,30 @@ def test_a_value_read_while_a_write_commits_is_not_cached_as_the_stored_one(db):
     assert db.generation != seen["generation"], "the old value would be taken for the stored one"
 
 
-def test_writers_of_one_process_take_turns_and_each_counts(db):
-    def write(x: float) -> None:
-        with db.unit() as unit:
-            unit.put_offset("G55", {"trans": {"X": x}}, source="test")
-
+def test_a_writer_never_sees_a_commit_not_yet_counted(db):
+    """A commit and the count's rise are one turn: another writer of this process that comes in
+    right after the commit waits until the count is raised, so it never caches the new value
+    under the old count (the measuring service's frame cache relies on this)."""
     before = db.generation
-    threads = [threading.Thread(target=write, args=(float(i),)) for i in range(8)]
-    for thread in threads:
-        thread.start()
-    for thread in threads:
-        thread.join()
-    assert db.generation == before + 8
+    seen: dict[str, object] = {}
+
+    def other_writer() -> None:
+        with db.unit() as unit:
+            seen["generation"] = db.generation
+            seen["x"] = unit.get_offset("G54")["trans"]["X"]
+
+    other = threading.Thread(target=other_writer)
+
+    def after_commit(_session) -> None:           # committed, the count not raised yet
+        if not other.is_alive() and not seen:
+            other.start()
+            other.join(timeout=0.3)                # time enough to come in, were the turn free
+
+    event.listen(Session, "after_commit", after_commit)
+    try:
+        with db.unit() as unit:
+            unit.put_offset("G54", {"trans": {"X": 12.5}}, source="test")
+    finally:
+        event.remove(Session, "after_commit", after_commit)
+    other.join(timeout=15)
+    assert seen == {"generation": before + 1, "x": 12.5}

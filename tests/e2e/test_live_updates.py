@@ -135,20 +135,20 @@ def test_the_outcome_shows_although_a_progress_answer_came_too_late(browser, liv
         open_ring_calibration(page)
         page.evaluate("() => { window.givenUp = 0; document.addEventListener('htmx:timeout', () => window.givenUp++); }")
         held = []
+        gave_up = threading.Event()
 
         def hold_the_outcome(route) -> None:      # answers with the outcome never arrive, until one was given up
             answer = route.fetch()
-            if 'id="task-result"' in answer.text() and not page_gave_up:
+            if 'id="task-result"' in answer.text() and not gave_up.is_set():
                 held.append(route)
             else:
                 route.fulfill(response=answer)
 
-        page_gave_up = False
         page.route("**/progress*", hold_the_outcome)
         page.locator("#nc-start").click()
         expect(page.locator("#task-progress")).to_contain_text("Measuring P1")
         page.wait_for_function("() => window.givenUp > 0", timeout=60000)
-        page_gave_up = True
+        gave_up.set()
         assert held, "no answer with the outcome was held back: the test proved nothing"
         expect(page.locator("#task-result")).to_be_visible(timeout=10000)
         page.unroute("**/progress*")
