@@ -59,10 +59,7 @@ import numpy.typing as npt
 from engine.types import FloatArray
 
 if TYPE_CHECKING:                      # engine.calibration imports this module
-    from engine.calibration import RingTouch
     from engine.frames import Frame
-    from engine.planes import Plane
-    from engine.types import ProbeRecord
 
 FRAMES = ("probe", "machine")
 
@@ -270,15 +267,6 @@ def fit_lobing_map(angles_deg: npt.ArrayLike, values: npt.ArrayLike, *, frame: s
                      skew=np.asarray(skew, dtype=float)[:2].copy(), covariance=cov,
                      fit_residuals=rho - basis @ coefficients, axial_radius=axial_radius,
                      projector=projector)
-
-
-def estimate_lobing(touches: Sequence[RingTouch], diameter: float, probe: ProbeRecord, plane: Plane,
-                    **options: Any) -> LobingMap:
-    """The lobing map of an n-direction ring calibration: ``engine.calibration.estimate_ring``
-    (same arguments) and its ``lobing``; see there for the estimator."""
-    from engine.calibration import estimate_ring  # calibration imports this module
-
-    return estimate_ring(touches, diameter, probe, plane, **options).lobing
 
 
 def lobing_map_from_json(data: dict[str, Any]) -> LobingMap:

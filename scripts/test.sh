@@ -29,4 +29,6 @@ fi
 .venv/bin/ruff check app engine db tests bench
 # types (pyproject [tool.mypy]): engine/ and db/ strict, app/ with its untyped defs checked
 .venv/bin/mypy
+# import contracts (.importlinter): the layers of design.md §2 and no cycles, function-level imports included
+.venv/bin/lint-imports --no-cache >/dev/null || .venv/bin/lint-imports --no-cache
 exec .venv/bin/python -m pytest "$@"

@@ -17,7 +17,7 @@ from starlette.concurrency import run_in_threadpool
 
 from app.access.deps import needs, require_measurement
 from app.errors import WorkflowError
-from app.i18n import N_, _
+from app.i18n import N_, _, language
 from app.services.measuring import MeasuringEnv
 from app.workflow import planning
 from app.workflow.executor import StepExecutor
@@ -37,7 +37,16 @@ from .task_forms import (
     values_from_params,
 )
 from .task_svg import draw
-from .templating import ANGLE_KEYS, fmt_result, is_htmx, render_block, render_blocks, render_screen, url_path
+from .templating import (
+    ANGLE_KEYS,
+    fmt_result,
+    is_htmx,
+    render_block,
+    render_blocks,
+    render_screen,
+    templates,
+    url_path,
+)
 from .texts import field_name
 
 router = APIRouter()
@@ -189,6 +198,25 @@ RESULT_LABELS = [
     ("length", N_("Length L")), ("width", N_("Width W")), ("radius", N_("Radius R")), ("angle", N_("Angle α")),
     ("angle_2", N_("Angle of 2nd edge")), ("corner_angle", N_("Corner angle")), ("alpha", N_("Alpha α")), ("beta", N_("Beta β")),
 ]
+
+
+def task_name(task: str) -> str:
+    """A measuring task id (``edge.set``) as its softkey text in the screen's language."""
+    page = PAGES.get(task)
+    return _(page.label) if page is not None else task
+
+
+def result_label(key: str) -> str:
+    """A result key of the set-up support's tables: the key in English (as before), the measuring
+    screen's label in another language."""
+    if language() == "en":
+        return key
+    return _(dict(RESULT_LABELS).get(key, key))
+
+
+# here rather than in templating.py, which this module imports (texts.py had to import back)
+templates.env.globals["task_name"] = task_name
+templates.env.globals["result_label"] = result_label
 TOOL_LABELS = {"length": N_("Length L1"), "radius": N_("Radius R")}
 
 

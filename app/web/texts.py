@@ -248,14 +248,6 @@ def log_status_text(status) -> str:
     return _(LOG_STATUS[status]) if status in LOG_STATUS else str(status or "")
 
 
-def task_name(task: str) -> str:
-    """A measuring task id (``edge.set``) as its softkey text in the screen's language."""
-    from app.web.task_screens import PAGES
-
-    page = PAGES.get(task)
-    return _(page.label) if page is not None else task
-
-
 # texts of the services that reach the screens as they are (their msgid is the English text)
 SERVICE_TEXTS = (
     N_("You are compensating in an inactive WO!"), N_("The new WCS needs a new alignment!"),
@@ -316,16 +308,6 @@ message(r"Measurement done: WO activated", N_("Measurement done: WO activated"))
 message(r"Measurement done", N_("Measurement done"))
 message(r"Calculated: WO activated", N_("Calculated: WO activated"))
 message(r"Calculated", N_("Calculated"))
-
-
-def result_label(key: str) -> str:
-    """A result key of the set-up support's tables: the key in English (as before), the measuring
-    screen's label in another language."""
-    if language() == "en":
-        return key
-    from app.web.task_screens import RESULT_LABELS
-
-    return _(dict(RESULT_LABELS).get(key, key))
 
 
 def result_value(key: str, value) -> str:
