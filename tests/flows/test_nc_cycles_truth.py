@@ -41,6 +41,14 @@ def note(name: str, deviation: float) -> None:
     WORST[name] = max(WORST.get(name, 0.0), abs(float(deviation)))
 
 
+@pytest.fixture(scope="module", autouse=True)
+def _print_worst_deviations():
+    """After this module's tests: the worst deviation per cycle (the report's figures; pytest -s)."""
+    yield
+    for name, dev in sorted(WORST.items()):
+        print(f"{name:24s} {dev:.3g} mm")
+
+
 def close(name: str, actual, expected, tol: float = TOL_MM) -> None:
     a, e = np.asarray(actual, float), np.asarray(expected, float)
     dev = float(np.max(np.abs(a - e))) if a.size else 0.0
@@ -412,9 +420,3 @@ def test_cycle971_calibrates_the_tool_probe_and_measures_a_cutter(client):
     close("CYCLE971 radius", nc.ovr()[10], 5.0)
     close("CYCLE971 radius", nc.ok(nc.c.get("/api/tools/1"))["radius"], 5.0)
     assert nc.ovi()[8] == 1
-
-
-def test_zz_worst_deviations():
-    """Prints the worst deviation per cycle (the report's figures)."""
-    for name, dev in sorted(WORST.items()):
-        print(f"{name:24s} {dev:.3g} mm")

@@ -35,11 +35,19 @@ from truthkit import (
 ROT_Z = 4.0
 DEPTH = -10.0          # part z of edge/corner touches on the block's sides
 POCKET_DEPTH = -8.0    # part z inside holes and the pocket
-WORST: dict[str, float] = {}   # worst deviation per task (printed by the last test)
+WORST: dict[str, float] = {}   # worst deviation per task (printed after the module)
 
 
 def note(task: str, *deviations: float) -> None:
     WORST[task] = max(WORST.get(task, 0.0), *(abs(float(d)) for d in deviations))
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _print_worst_deviations():
+    """After this module's tests: the worst deviation per task (the report's figures; pytest -s)."""
+    yield
+    for name, dev in sorted(WORST.items()):
+        print(f"{name:24s} {dev:.3g} mm")
 
 
 def close(actual, expected, tol=TOL_MM, task: str | None = None):
@@ -448,9 +456,3 @@ def test_plane_align_tilted(client, target):
     codes = [r["code"] for r in ans["setup_support"]["reasons"]]
     assert "realign" in codes
     assert ("inactive_wo" in codes) == (target == "G56")
-
-
-def test_report_worst_deviation():
-    """Prints the worst deviation per task of this module's runs (pytest -s)."""
-    for task, dev in sorted(WORST.items()):
-        print(f"{task:14s} {dev:.3g}")
