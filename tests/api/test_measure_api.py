@@ -8,11 +8,11 @@ from __future__ import annotations
 
 import sys
 import threading
-import time
 from pathlib import Path
 
 import numpy as np
 import pytest
+from waiting import wait_until
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "flows"))
 from truthkit import HOLE_D, HOLES, SPIGOT_H, SPIGOTS, Operator, scenario  # noqa: E402
@@ -196,10 +196,7 @@ def run_start(op: Operator, sid: str) -> tuple[threading.Thread, dict]:
 
     thread = threading.Thread(target=target, daemon=True)
     thread.start()
-    deadline = time.monotonic() + 5.0
-    while not op.ok(op.c.get("/api/machine"))["busy"]:
-        assert time.monotonic() < deadline, "the measurement did not start"
-        time.sleep(0.01)
+    wait_until(lambda: op.ok(op.c.get("/api/machine"))["busy"], "the measurement starts")
     return thread, out
 
 
@@ -212,10 +209,9 @@ def test_reset_during_nc_start_stores_nothing(op):
     error_of(op.c.post("/api/measure", json={"task": "hole.1", "params": {}}), 409, "busy")
     error_of(op.c.post(f"/api/measure/{sid}/points/1/invalidate"), 409, "busy")
     assert op.ok(op.c.get(f"/api/measure/{sid}"))["busy"] is True
-    t0 = time.monotonic()
     op.ok(op.c.post("/api/machine/reset"))
-    thread.join(timeout=5.0)
-    assert not thread.is_alive() and time.monotonic() - t0 < 2.0
+    thread.join(timeout=5.0)                   # how soon it ends is a figure of bench/, not a bar here
+    assert not thread.is_alive()
     error_of(out["response"], 409, "alarm")
     session = op.ok(op.c.get(f"/api/measure/{sid}"))
     assert not session["points"][0]["stored"] and session["busy"] is False

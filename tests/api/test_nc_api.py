@@ -6,9 +6,9 @@ MCS Z −120, a Ø20 hole at part (40, 30) = MCS (290, 180)."""
 from __future__ import annotations
 
 import threading
-import time
 
 import pytest
+from waiting import wait_until
 
 HOLE = (290.0, 180.0)
 BORE = """N10 G500 G17 G90 G0 Z-100
@@ -160,7 +160,7 @@ def test_a_run_while_running_is_409(client):
     services.nc.runtime.move = slow
     try:
         ok(client.post("/api/nc/run", json={"mda": "G500 G0 Z-100", "wait": False}), 202)
-        time.sleep(0.05)
+        wait_until(lambda: ok(client.get("/api/nc"))["state"] == "running", "the program runs")
         assert ok(client.post("/api/nc/run", json={"mda": "M30"}), 409)["error"]["code"] == "busy"
         assert ok(client.put("/api/nc/variables/R1", json={"value": 1}), 409)
         assert ok(client.get("/api/nc"))["state"] == "running"

@@ -12,6 +12,7 @@ from asyncua import Client, ua
 from hmi_testdata import TEST_SCENARIO
 from live import free_port, serve
 from opc_kit import add_users, run
+from waiting import wait_until
 
 MT, MACHINERY, DI = ("http://opcfoundation.org/UA/MachineTool/", "http://opcfoundation.org/UA/Machinery/",
                      "http://opcfoundation.org/UA/DI/")
@@ -28,9 +29,7 @@ def umati(tmp_path_factory):
     with serve(tmp_path_factory.mktemp("umati"), TEST_SCENARIO, start_timeout_s=90.0,
                settings={"opcua_port": opc_port, "opcua_umati": True}, prepare=prepare) as url:
         endpoint = built["app"].state.endpoints[0]
-        deadline = time.monotonic() + 60
-        while endpoint.umati_state == "loading" and time.monotonic() < deadline:
-            time.sleep(0.2)
+        wait_until(lambda: endpoint.umati_state != "loading", "the umati model loads", 60.0)
         assert endpoint.umati_state == "loaded"
         with httpx.Client(base_url=url, headers={"Authorization": f"Bearer {built['token']}"}, timeout=10) as http:
             yield http, f"opc.tcp://127.0.0.1:{opc_port}"

@@ -1,11 +1,11 @@
 """The simulator's parts on their own: kinematics, contact, motion, the NC's data copy."""
 
 import threading
-import time
 
 import numpy as np
 import pytest
 from sim_helpers import rotation, scenario
+from waiting import wait_until
 
 from app.machine.contact import Contact
 from app.machine.kinematics import Kinematics
@@ -91,7 +91,7 @@ def test_motion_claims_the_axes_and_stops_a_timed_travel():
 
     worker = threading.Thread(target=timed_move)
     worker.start()
-    time.sleep(0.1)
+    wait_until(lambda: motion.position[0] > 5.0, "the timed move is under way")
     assert motion.busy
     with pytest.raises(MachineBusy):
         motion.begin()
