@@ -13,6 +13,8 @@ from __future__ import annotations
 from fastapi import Depends, Request, Security
 from fastapi.security import APIKeyCookie, HTTPBearer
 
+from app.errors import WorkflowError
+
 from .errors import AccessDenied, Unauthenticated
 from .identity import INVALID, NOBODY, Identity
 from .levels import FUNCTIONS, UNDECLARED_WRITE, required_level
@@ -136,7 +138,7 @@ def require_measurement(request: Request, task: str, target) -> None:
     services = request.app.state.services
     try:
         spec = services.workflow.spec(task)
-    except Exception:          # an unknown task: the workflow names the error
+    except WorkflowError:      # an unknown task: the workflow names the error
         return
     if target is None and spec.corrects_zero_offset:
         target = services.machine.active_offset

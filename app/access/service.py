@@ -18,7 +18,7 @@ import secrets
 import threading
 import time
 from datetime import UTC, datetime, timedelta
-from http.cookies import SimpleCookie
+from http.cookies import CookieError, SimpleCookie
 
 from pwdlib import PasswordHash
 
@@ -292,7 +292,7 @@ def session_secret(cookie_header: str | None) -> str | None:
     cookies = SimpleCookie()
     try:
         cookies.load(cookie_header)
-    except Exception:        # a malformed Cookie header is no session
+    except CookieError:      # a malformed Cookie header is no session
         return None
     morsel = cookies.get(SESSION_COOKIE)
     return morsel.value if morsel is not None and morsel.value else None

@@ -8,7 +8,7 @@ centre. The set-up error is the simulator's answer (app/machine/sim_trainer.py).
 
 from __future__ import annotations
 
-from app.errors import ConflictError, InvalidInput
+from app.errors import ConflictError, InvalidInput, NotFoundError
 from app.machine.protocol import MachineAlarm, SimulatorControl
 from app.machine.scenario import Scenario
 
@@ -55,7 +55,7 @@ def _tool_radius(services, t) -> float:
         return 0.0
     try:
         row = services.tools.get(t)
-    except Exception:           # no tool data: drawn as a point
+    except (NotFoundError, InvalidInput):   # no tool data: drawn as a point
         return 0.0
     return float(row.get("radius") or 0.0)
 

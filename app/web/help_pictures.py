@@ -14,6 +14,7 @@ from html import escape
 
 from markupsafe import Markup
 
+from app.errors import InvalidInput, NotFoundError
 from engine.plan_workpiece import corner_direction
 from engine.planes import Plane
 
@@ -326,7 +327,7 @@ def equipment_rows(services, task: str) -> list[tuple[str, str]]:
     if family in ("toolprobe", "tool"):
         try:
             tp = services.tool_probes.get(int(gud.tool_probe_number))
-        except Exception:
+        except (NotFoundError, InvalidInput, ValueError, TypeError):    # no record, or no number set
             return [("Tool probe", f"{gud.tool_probe_number}: no data")]
         rows.append(("Tool probe", f"{tp['number']}, disc Ø {float(tp.get('disc_diameter') or 0):.3f} mm"))
         rows.append(("Calibrated", f"length {_yes(tp.get('calibrated_length'))}, "
@@ -336,7 +337,7 @@ def equipment_rows(services, task: str) -> list[tuple[str, str]]:
         return rows
     try:
         probe = services.probes.get(int(gud.probe_number))
-    except Exception:
+    except (NotFoundError, InvalidInput, ValueError, TypeError):
         return [("Probe data", f"{gud.probe_number}: no data")]
     effective = float(probe.get("effective_diameter") or 0.0)
     ball = f"Ø {float(probe.get('ball_diameter') or 0):.3f} mm"

@@ -9,10 +9,11 @@ messages are a contract for programs, which translate by the error ``code``.
 
 from __future__ import annotations
 
-from http.cookies import SimpleCookie
+from http.cookies import CookieError, SimpleCookie
 from urllib.parse import parse_qs
 
 from app.i18n import DEFAULT_LANGUAGE, LANGUAGES, reset_language, set_language
+from db.database import StorageUnavailable
 
 COOKIE = "hmi_lang"
 COOKIE_MAX_AGE = 365 * 24 * 3600
@@ -59,7 +60,7 @@ def _setting(scope) -> str | None:
     app = scope.get("app")
     try:
         return app.state.services.settings.get().language
-    except Exception:           # no app state (tests of the middleware alone), or storage trouble
+    except (AttributeError, StorageUnavailable):   # no app state (the middleware alone), or no storage
         return None
 
 
@@ -84,7 +85,7 @@ class LanguageMiddleware:
             cookies = SimpleCookie()
             try:
                 cookies.load(_header(scope, b"cookie"))
-            except Exception:
+            except CookieError:         # a malformed Cookie header: no cookie language
                 pass
             cookie_lang = cookies[COOKIE].value if COOKIE in cookies else None
             lang = choose(chosen, cookie_lang, _setting(scope), _header(scope, b"accept-language"))

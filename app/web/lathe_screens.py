@@ -16,6 +16,7 @@ from app.workflow.executor import StepExecutor
 from engine.turning_plan import lathe_planned_path, prepare
 from engine.types import MoveStep, ProbeStep
 
+from .failsafe import EXPECTED, picture_failed
 from .lathe_view import lathe_svg
 from .templating import fmt_result
 
@@ -106,7 +107,7 @@ def lathe_tool_info(env) -> dict | None:
         return info
     try:
         row = env.services.tools.get(t)
-    except Exception:
+    except EXPECTED:
         return info
     wear = row.get("wear") or {}
     info.update(type=row.get("type"), sl=row.get("sl"), l1=row.get("l1"), l2=row.get("l2"),
@@ -141,8 +142,10 @@ def lathe_svgs(env, spec, params: dict | None, answer: dict | None) -> list:
     try:
         scene = env.machine.scene_geometry()
         limits = env.machine.scenario.limits()
-    except Exception:
+    except EXPECTED:
         return []
+    except Exception:
+        return [picture_failed("the lathe set-up")]
     path = None
     if params is not None and not (answer or {}).get("result"):
         try:
@@ -154,8 +157,10 @@ def lathe_svgs(env, spec, params: dict | None, answer: dict | None) -> list:
             start = StepExecutor(env.machine.machine, ctx.chain().wcs2bcs, ctx.tool_length, ctx.plane.infeed_unit,
                                  tip=tip).current(prep.coords)
             path = _path_points(prep, start, tip)
-        except Exception:
+        except EXPECTED:
             path = None
+        except Exception:
+            return [picture_failed("the lathe's planned path")]
     focus = {"lathe.toolprobe.calibrate": ("tool_probe",), "lathe.tool.measure": ("tool_probe",),
              "lathe.tool.auto": ("tool_probe",), "lathe.probe.groove": ("groove",)}.get(spec.name, ("part",))
     return [Markup(lathe_svg(scene, limits, path=path, svg_id="task-lathe", focus=focus,

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 from fastapi import APIRouter, HTTPException, Request, Response
 
+from app.errors import WorkflowError
 from app.i18n import N_, _
 
 from .templating import render_screen, softkey, url_path, vkeys
@@ -132,7 +133,7 @@ def _leaf_denied(request: Request, task: str) -> str:
 
     try:
         function = measuring_function(task_spec(task).category, "measure_only")
-    except Exception:
+    except WorkflowError:              # an unknown task: its screen names the error
         return ""
     return denied(request, function) if function else ""
 

@@ -28,6 +28,8 @@ from engine.plan import ideal_path
 from engine.planes import Plane
 from engine.types import MoveStep, ProbeStep
 
+from .failsafe import EXPECTED, log
+
 LOG_ENTRIES = 3          # the last measurements drawn as touches and results
 AXES = ("X", "Y", "Z")
 
@@ -90,7 +92,10 @@ def _plan(services, session) -> dict | None:
         executor = StepExecutor(services.machine.machine, wcs2bcs, ctx.tool_length, ctx.plane.infeed_unit)
         start = np.asarray(executor.current(spec.coords))
         steps = ideal_path(spec.program(session.params, n, start, planning.context_from(ctx)), start)
-    except Exception:          # a preview never breaks the view (the screen shows why NC Start refuses)
+    except EXPECTED:           # the measuring screen shows why NC Start refuses
+        return None
+    except Exception:          # a bug: logged; the view goes on without the path
+        log.exception("the 3D view's planned path")
         return None
     to_mcs = wcs2bcs.child2parent if spec.coords == "WCS" else (lambda p: np.asarray(p, dtype=float))
     segments, pos = [], start
@@ -132,7 +137,7 @@ def _session_touches(session) -> list[dict]:
 def _recent(services) -> list[dict]:
     try:
         return [e for e in services.log.list(limit=LOG_ENTRIES) if e.get("status") == "ok"]
-    except Exception:
+    except EXPECTED:
         return []
 
 
@@ -162,18 +167,18 @@ def _entry_frame(entry: dict, frames: dict[str, Frame]) -> Frame | None:
     if isinstance(target, str) and corr.get("before") and (target == wo or is_basic(target)):
         try:
             frames = {**frames, target: Frame.from_api(corr["before"])}
-        except Exception:
+        except (ValueError, KeyError, TypeError):     # an entry older than today's frame format
             return None
     try:
         return chain_of(frames, wo).wcs2bcs
-    except Exception:
+    except (ValueError, KeyError):                    # its WO no longer exists
         return None
 
 
 def _measured(services, plane: Plane) -> list[dict]:
     try:
         frames = services.machine.stored_frames()
-    except Exception:
+    except EXPECTED:
         return []
     out = []
     for entry in _recent(services):

@@ -27,6 +27,7 @@ from engine.plan import ideal_path
 from engine.tasks import Family
 
 from . import measure, task_help, units
+from .failsafe import EXPECTED, picture_failed
 from .lathe_screens import lathe_correction_rows, lathe_result_rows, lathe_svgs, lathe_tool_info
 from .task_forms import (
     field_of_error,
@@ -315,8 +316,10 @@ def _svgs(env: _Env, task: str, params: dict | None, session, answer: dict | Non
         ctx = env.measuring_context()
         start = StepExecutor(env.machine.machine, ctx.chain().wcs2bcs, ctx.tool_length,
                              ctx.plane.infeed_unit).current(spec.coords)
-    except Exception:       # the preview must never break the screen
+    except EXPECTED:        # no probe position or no data: the screen says why
         return []
+    except Exception:       # a bug: logged, and shown in the picture's place
+        return [picture_failed("the measuring preview")]
     steps = []
     result = (answer or {}).get("result")
     if params is not None and not result:
@@ -324,8 +327,10 @@ def _svgs(env: _Env, task: str, params: dict | None, session, answer: dict | Non
         try:
             normalised = spec.validate(params, ctx.plane)
             steps = ideal_path(spec.program(normalised, n, np.asarray(start), planning.context_from(ctx)), start)
-        except Exception:
+        except EXPECTED:    # parameters the form marks as wrong: no path yet
             steps = []
+        except Exception:
+            return [picture_failed("the planned path")]
     points = session.to_api()["points"] if session is not None else []
     radius = ctx.probe.ball_diameter / 2.0 if ctx.probe else float((ctx.tool or {}).get("radius") or 1.0)
     return draw(task, ctx.plane, params=params, start=start, steps=steps, points=points, result=result,
@@ -363,7 +368,7 @@ def _screen_context(env: _Env, page: TaskPage, form: dict | None, *, answer=None
             try:
                 row = env.services.tools.get(st["tool"])
                 tool["radius"] = float(row.get("radius") or 0.0) + float((row.get("wear") or {}).get("radius") or 0.0)
-            except Exception:
+            except EXPECTED:
                 tool["radius"] = None
     warnings = list((answer or {}).get("warnings") or (session.warnings if session is not None else []))
     if spec.lathe:

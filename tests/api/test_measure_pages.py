@@ -182,3 +182,16 @@ def test_the_csv_export_has_every_log_field_a_bom_and_the_local_time(client):
     assert refused.status_code == 422 and refused.json()["error"]["field"] == "tz"
     plain = client.get("/log/export.csv").text
     assert not plain.startswith("\ufeff") and plain.startswith("id,time,task,target")
+
+
+def test_a_bug_while_drawing_the_preview_is_logged_and_shown_not_an_empty_picture(client, monkeypatch, caplog):
+    def broken(*_args, **_kwargs):
+        raise TypeError("a bug in the planning")
+
+    monkeypatch.setattr("app.web.task_screens.StepExecutor", broken)
+    with caplog.at_level("ERROR", logger="app.web"):
+        text = client.get("/measure/workpiece/edge/set", headers=HTMX).text
+    assert "The picture could not be drawn: internal error (see the HMI log)." in text
+    assert "No preview (no probe position)." not in text
+    logged = [r for r in caplog.records if r.name == "app.web" and r.exc_info]
+    assert logged and "a bug in the planning" in str(logged[0].exc_info[1])
