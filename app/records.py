@@ -191,18 +191,6 @@ class ToolData(BaseModel):
         return self.sl is not None or self.l1 is not None or self.l2 is not None
 
 
-def tool_out(data: Mapping) -> dict:
-    """A validated tool dict without the lathe fields a milling tool does not have (None)."""
-    out = {k: v for k, v in dict(data).items() if not (k in ("sl", "l1", "l2") and v is None)}
-    if isinstance(out.get("wear"), Mapping):
-        out["wear"] = {k: v for k, v in out["wear"].items() if not (k in ("l1", "l2") and v is None)}
-    return out
-
-
 LATHE_RECORD_KEYS = ("position_deviation", "workpiece_trigger")   # probe / tool probe records of a lathe
 LATHE_PROBE_TYPE = 580      # the lathe's workpiece probe: a 5xy tool with SL 5..8 (turning.md §0.6)
 
-
-def is_lathe_probe_tool(tool: Mapping | None) -> bool:
-    """A tool table row of the lathe's workpiece probe (type 580)."""
-    return tool is not None and bool(tool) and int(tool.get("type", 0) or 0) == LATHE_PROBE_TYPE

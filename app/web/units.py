@@ -15,7 +15,7 @@ from contextlib import contextmanager
 from contextvars import ContextVar
 from decimal import Decimal, InvalidOperation
 
-from app.i18n import _, decimal_symbol, format_fixed, format_number, language
+from app.i18n import decimal_symbol, format_fixed, format_number, language
 
 MM_PER_INCH = 25.4
 _MM_PER_INCH = Decimal("25.4")
@@ -125,15 +125,6 @@ def parse_length(text, gud, stored_mm: float | None = None) -> float:
     if not math.isfinite(result):
         raise NumberError(str(text))
     return result
-
-
-def parse_length_or_none(text, gud, stored_mm: float | None = None) -> float | None:
-    return None if str(text or "").strip() == "" else parse_length(text, gud, stored_mm)
-
-
-def enter_a_number(label: str) -> str:
-    """The operator's message for typed text that is no number."""
-    return _("%(field)s: enter a number", field=label)
 
 
 def mm_text_of(text, gud, stored_mm: float | None = None) -> str:
