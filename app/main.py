@@ -61,7 +61,8 @@ STATIC_DIR = ROOT / "static"
 
 def build_services(settings: Settings, scenario: Scenario | LatheScenario) -> Services:
     controller = build_machine(settings.machine, scenario)   # an unknown name fails before the db is touched
-    db = Database(settings.db_path, rotary_axes=tuple(a for a in scenario.axes if a not in "XYZ"))
+    db = Database(settings.database, rotary_axes=tuple(a for a in scenario.axes if a not in "XYZ"),
+                  machine=settings.machine_name)
     gud = SettingsService(db)
     machine = MachineService(db, controller, scenario, gud,
                              rebuild=lambda other: build_machine(settings.machine, other))   # lathe <-> mill
