@@ -5,9 +5,10 @@ from __future__ import annotations
 from typing import Annotated
 
 from fastapi import APIRouter, Body, Path, Query
+from fastapi.responses import PlainTextResponse
 
 from app.access.deps import needs
-from app.deps import ResultsDep
+from app.deps import NcDep, ResultsDep
 
 router = APIRouter(tags=["results"])
 JsonObject = Annotated[dict, Body()]
@@ -49,3 +50,17 @@ def list_parts(results: ResultsDep, part_number: Annotated[str | None, Query(max
 @router.get("/parts/{part_id}", name="api_part")
 def get_part(part_id: Annotated[int, Path(ge=1, le=2**63 - 1)], results: ResultsDep) -> dict:
     return results.part(part_id)
+
+
+@router.get("/protocols", name="api_protocols")
+def list_protocols(nc: NcDep) -> list[dict]:
+    """The protocol files of CYCLE100…CYCLE106 (manual §7.1): ``{"name", "program", "updated",
+    "size", "lines"}``."""
+    return nc.protocol_files.list()
+
+
+@router.get("/protocols/{name}", name="api_protocol", response_class=PlainTextResponse)
+def get_protocol(name: Annotated[str, Path(max_length=40)], nc: NcDep, download: bool = False) -> PlainTextResponse:
+    """The protocol file as text (``download=true``: as an attachment ``<name>.MPF``)."""
+    headers = {"Content-Disposition": f'attachment; filename="{name}.MPF"'} if download else None
+    return PlainTextResponse(nc.protocol_files.text(name), headers=headers)

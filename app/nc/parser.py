@@ -37,7 +37,7 @@ _TERMINAL_WORDS = {
     "BLOCKNO": "a block number", "CMP_OP": "a comparison", "ADD_OP": "'+' or '-'",
     "MUL_OP": "'*' or '/'",
 }
-_EXPRESSION_START = {"NUMBER", "INT_NUMBER", "NAME", "RPARAM", "STRING", "LPAR", "ADD_OP", "NOT",
+_EXPRESSION_START = {"NUMBER", "INT_NUMBER", "NAME", "RPARAM", "STRING", "LPAR", "ADD_OP", "NOT", "CONCAT",
                      "TRUE", "FALSE"}
 _UNSUPPORTED_ADDRESS = {
     "I": "circle and helix parameters (I, J, K) are not part of this control's language",
