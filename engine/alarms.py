@@ -307,6 +307,10 @@ NO_MEASURING_PATH = _define(
 NC_VALUE_RANGE = _define(
     65103, "NC_VALUE_RANGE", "Programmed value out of range", "编程值超出范围",
     "Correct the value shown in the message (sign, integer, size or range).")
+NC_RUNAWAY = _define(
+    65104, "NC_RUNAWAY", "Program runaway stopped: loop limit or watchdog", "程序失控已停止：循环上限或看门狗",
+    "The program repeats a jump without end or computes too long without moving: correct the loop's "
+    "condition, then press Reset.")
 NC_INTERNAL = _define(
     65199, "NC_INTERNAL", "Internal error of the part-program interpreter", "零件程序解释器内部错误",
     "Note the block and the message, press Reset and report it.")

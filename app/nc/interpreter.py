@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 import threading
+import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
@@ -224,6 +225,11 @@ class CycleContext:
 
 _IDLE, _READY, _RUNNING, _STOPPED, _DONE, _ALARM = "idle", "ready", "running", "stopped", "done", "alarm"
 
+#: jumps one NC Start may execute: a loop beyond it is a runaway (alarm NC_RUNAWAY)
+MAX_JUMPS = 100_000
+#: seconds a run may compute without a command to the machine before the watchdog ends it
+WATCHDOG_S = 10.0
+
 
 class _Control:
     """How a block ends: go on, jump, stop (M0) or end the program."""
@@ -244,8 +250,12 @@ class Interpreter:
 
     def __init__(self, runtime: NcRuntime, variables: Variables | None = None,
                  cycles: Mapping[str, CycleHandler] | None = None, *, defaults: ModalState | None = None,
-                 on_block: Callable[[BlockRef], None] | None = None):
+                 on_block: Callable[[BlockRef], None] | None = None, max_jumps: int = MAX_JUMPS,
+                 watchdog_s: float = WATCHDOG_S):
         self.runtime = runtime
+        self.max_jumps = max_jumps
+        self.watchdog_s = watchdog_s
+        self._commands = 0                  # machine commands given (the watchdog's sign of life)
         self.variables = variables if variables is not None else Variables(axes=runtime.axes)
         self.cycles: Mapping[str, CycleHandler] = cycles if cycles is not None else {}
         self._defaults = defaults or ModalState()
@@ -371,6 +381,7 @@ class Interpreter:
             self._stop.clear()
         program = self._program
         last: BlockRef | None = None
+        watch = _Watchdog(self)
         try:
             while True:
                 if self._pc >= len(program.blocks):
@@ -387,6 +398,7 @@ class Interpreter:
                 last = ref
                 if control.kind == "end":
                     return self._finish(_DONE, control.reason, last)
+                watch.check(block, control)
                 if control.kind == "jump":
                     assert control.target is not None       # a jump names its block (_execute_block)
                     self._pc = control.target
@@ -444,6 +456,7 @@ class Interpreter:
 
     def _located(self, word, call):
         """Run ``call``; an ``NcRuntimeError`` becomes an alarm located at ``word``."""
+        self._commands += 1
         try:
             return call()
         except NcRuntimeError as e:
@@ -874,6 +887,32 @@ class Interpreter:
 
 
 # --- helpers -----------------------------------------------------------------------------------------
+
+class _Watchdog:
+    """The run-time bounds of one NC Start: at most ``max_jumps`` jumps, and no more than
+    ``watchdog_s`` seconds of blocks without a command to the machine (a computing loop)."""
+
+    def __init__(self, interp: Interpreter):
+        self._interp = interp
+        self._jumps = 0
+        self._commands = interp._commands
+        self._since = time.monotonic()
+
+    def check(self, block: n.Block, control: _Control) -> None:
+        interp = self._interp
+        if control.kind == "jump":
+            self._jumps += 1
+            if self._jumps > interp.max_jumps:
+                raise NcAlarm(f"the program jumped {interp.max_jumps} times without ending: a loop that never ends "
+                              "(check its condition)", block.line, block.pos.column, alarm=alarms.NC_RUNAWAY,
+                              block_text=block.text)
+        now = time.monotonic()
+        if interp._commands != self._commands:
+            self._commands, self._since = interp._commands, now
+        elif now - self._since > interp.watchdog_s:
+            raise NcAlarm(f"the program computed for {interp.watchdog_s:g} s without moving: watchdog",
+                          block.line, block.pos.column, alarm=alarms.NC_RUNAWAY, block_text=block.text)
+
 
 def _expressions(w) -> list[n.Expr]:
     if isinstance(w, n.Assign):
