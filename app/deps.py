@@ -21,6 +21,7 @@ from app.services import (
     ToolProbeService,
     ToolService,
 )
+from app.services.plant import PlantService
 from app.services.plc import PlcSimulator
 from app.workflow.service import WorkflowService
 
@@ -53,3 +54,4 @@ ProgramsDep = Annotated[ProgramService, _part("programs")]
 PlcDep = Annotated[PlcSimulator, _part("plc")]
 ResultsDep = Annotated[ResultsService, _part("results")]
 QualityDep = Annotated[QualityService, _part("quality")]
+PlantDep = Annotated[PlantService, _part("plant")]

@@ -49,6 +49,7 @@ from app.services import (
     ToolService,
 )
 from app.services.measuring import MeasuringEnv
+from app.services.plant import PlantService
 from app.services.plc import PlcSimulator
 from app.services.scenarios import read_scenario
 from app.web import web_router
@@ -82,6 +83,7 @@ def build_services(settings: Settings, scenario: Scenario | LatheScenario) -> Se
     machine.mode_source = lambda: services.nc.mode
     machine.on_discard(services.workflow.discard_points)
     services.plc = PlcSimulator(lambda: services.workflow)
+    services.plant = PlantService(db, machine.status)
     return services
 
 
@@ -108,7 +110,12 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         endpoints = _app.state.endpoints
         for endpoint in endpoints:              # OPC UA, MTConnect: a start error stops the HMI's start
             await asyncio.to_thread(endpoint.start)
+        plant = services.plant
+        if plant is not None:                   # the plant view's heartbeat (design.md §10.5)
+            await asyncio.to_thread(plant.start)
         yield
+        if plant is not None:
+            plant.stop()
         for endpoint in reversed(endpoints):    # before the services they read close
             await asyncio.to_thread(endpoint.stop)
         if services.nc is not None:             # build_services made it

@@ -11,6 +11,7 @@ import threading
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
 from alembic import command
 from alembic.config import Config
@@ -183,6 +184,16 @@ class Database:
         with self._engine.connect() as connection:
             count = connection.scalar(select(Machine.writes).where(Machine.name == self.machine))
         return int(count or 0)
+
+    def report_status(self, status: dict[str, Any]) -> None:
+        """This HMI is alive, with ``status`` (alarms, mode, ...) for the plant view: its machines
+        row only, outside the write count (no cache need read again for it)."""
+        try:
+            with self._write_engine.begin() as connection:
+                connection.execute(update(Machine).where(Machine.name == self.machine)
+                                   .values(last_seen=utc_now(), status=status))
+        except OperationalError as exc:
+            raise StorageUnavailable(f"the database {self.where} cannot be written: {_cause(exc)}") from exc
 
     def offset_names(self) -> list[str]:
         """The configured frames in chain order (fixed when the database is opened)."""

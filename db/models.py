@@ -304,3 +304,4 @@ class Machine(Base):
     registered: Mapped[str] = mapped_column(String(40))                # UTC ISO 8601
     last_seen: Mapped[str] = mapped_column(String(40))
     writes: Mapped[int] = mapped_column(Integer, default=0)
+    status: Mapped[Any] = mapped_column(NullableJSON, nullable=True)   # what the HMI last reported

@@ -40,6 +40,7 @@ from db.models import (
     User,
 )
 from db.parts import PartsUnit
+from db.plant import PlantUnit
 
 CHANNEL = 1
 DEFAULT_PROBE_RECORDS = 3        # _CVAL[0], _CVAL[1]: 3 records each by default
@@ -140,7 +141,7 @@ def seed_defaults(session: Session, layout: Iterable[OffsetSlot], rotary_axes: I
                 session.add(model(machine=machine, number=number, calibrated_at=None, data={"number": number}))
 
 
-class Unit(PartsUnit):
+class Unit(PartsUnit, PlantUnit):
     """Repository methods of one transaction; all take and return plain JSON-ready values."""
 
     def __init__(self, session: Session, layout: tuple[OffsetSlot, ...], machine: str):

@@ -123,6 +123,7 @@ def upgrade() -> None:
         sa.Column("registered", sa.String(40), nullable=False),
         sa.Column("last_seen", sa.String(40), nullable=False),
         sa.Column("writes", sa.Integer(), nullable=False),
+        sa.Column("status", JSONB, nullable=True),
     )
     for table, items in _keyed_tables(with_machine=True).items():
         _rebuild(table, items, machine)
