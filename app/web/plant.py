@@ -23,7 +23,8 @@ def _when(iso: str | None) -> str:
 def _calibration(age_h: float | None) -> str:
     if age_h is None:
         return _("never")
-    return _("%(h)s h ago", h=f"{age_h:.1f}")
+    hours = f"{age_h:.1f}"
+    return _("%(h)s h ago", h=hours)
 
 
 def _row(machine: dict) -> dict:
