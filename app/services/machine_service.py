@@ -23,7 +23,6 @@ With a swivel head turned out of +Z the length goes along the machine's actual t
 
 from __future__ import annotations
 
-import math
 import threading
 import time
 from collections.abc import Callable, Mapping
@@ -33,6 +32,7 @@ from typing import overload
 
 import numpy as np
 
+from app import checks
 from app.errors import AlarmError, BusyError, ConflictError, InvalidInput, NotFoundError
 from app.machine.lathe_scenario import LatheScenario
 from app.machine.protocol import (
@@ -65,9 +65,7 @@ STATE_TOOL = "tool"
 
 
 def _finite(value, field: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise InvalidInput(f"{field}: must be a finite number", field=field)
-    return float(value)
+    return checks.number(value, field)
 
 
 def alarm_dict(alarm: Alarm) -> dict:
