@@ -14,6 +14,7 @@ from app.services import (
     OffsetService,
     ProbeService,
     ProgramService,
+    ResultsService,
     Services,
     SettingsService,
     ToolProbeService,
@@ -49,3 +50,4 @@ WorkflowDep = Annotated[WorkflowService, _part("workflow")]
 NcDep = Annotated[NcService, _part("nc")]
 ProgramsDep = Annotated[ProgramService, _part("programs")]
 PlcDep = Annotated[PlcSimulator, _part("plc")]
+ResultsDep = Annotated[ResultsService, _part("results")]

@@ -18,6 +18,7 @@ from .nc import NcService, ProgramService
 from .offsets import OffsetService
 from .plc import PlcSimulator
 from .probes import ProbeService, ToolProbeService
+from .results import ResultsService
 from .settings import SettingsService
 from .tools import ToolService
 
@@ -37,7 +38,8 @@ class Services:
     plc: PlcSimulator | None = None
     nc: NcService | None = None
     programs: ProgramService | None = None
+    results: ResultsService | None = None
 
 
-__all__ = ["LogService", "MachineService", "MemoryService", "NcService", "OffsetService", "ProbeService", "ProgramService",
+__all__ = ["LogService", "MachineService", "MemoryService", "NcService", "OffsetService", "ProbeService", "ProgramService", "ResultsService",
            "Services", "ToolProbeService", "SettingsService", "ToolService"]
