@@ -14,6 +14,7 @@ from app.services import (
     OffsetService,
     ProbeService,
     ProgramService,
+    QualityService,
     ResultsService,
     Services,
     SettingsService,
@@ -51,3 +52,4 @@ NcDep = Annotated[NcService, _part("nc")]
 ProgramsDep = Annotated[ProgramService, _part("programs")]
 PlcDep = Annotated[PlcSimulator, _part("plc")]
 ResultsDep = Annotated[ResultsService, _part("results")]
+QualityDep = Annotated[QualityService, _part("quality")]

@@ -18,6 +18,7 @@ from .nc import NcService, ProgramService
 from .offsets import OffsetService
 from .plc import PlcSimulator
 from .probes import ProbeService, ToolProbeService
+from .quality import QualityService
 from .results import ResultsService
 from .settings import SettingsService
 from .tools import ToolService
@@ -39,7 +40,8 @@ class Services:
     nc: NcService | None = None
     programs: ProgramService | None = None
     results: ResultsService | None = None
+    quality: QualityService | None = None
 
 
-__all__ = ["LogService", "MachineService", "MemoryService", "NcService", "OffsetService", "ProbeService", "ProgramService", "ResultsService",
+__all__ = ["LogService", "MachineService", "MemoryService", "NcService", "OffsetService", "ProbeService", "ProgramService", "QualityService", "ResultsService",
            "Services", "ToolProbeService", "SettingsService", "ToolService"]

@@ -38,6 +38,7 @@ from app.nc.runtime import MeasureResult
 from app.services.machine_service import MachineService
 from app.services.measuring import MeasuringEnv
 from app.services.memories import MEMORY_COUNT
+from app.services.protocols import ProtocolFileStore
 from app.services.settings import SettingsService
 from app.workflow.service import WorkflowService
 from db import Database
@@ -285,6 +286,7 @@ class NcService:
         self.runtime = MachineRuntime(machine_service, db)
         self.variables = Variables(axes=machine_service.axes, backings={
             "_EV": _memory_backing(db, "EV"), "_MV": _memory_backing(db, "MV")})
+        self.protocol_files = ProtocolFileStore(db)     # CYCLE100..CYCLE106 write here (design.md §10.3)
         self.cycles = measuring_cycles(self)
         self.interpreter = Interpreter(self.runtime, self.variables, self.cycles)
         self._lock = threading.RLock()
