@@ -20,6 +20,7 @@ from app.services import (
     ToolService,
 )
 from app.services.plc import PlcSimulator
+from app.services.probe_test import ProbeTestService
 from app.workflow.service import WorkflowService
 
 
@@ -49,3 +50,4 @@ WorkflowDep = Annotated[WorkflowService, _part("workflow")]
 NcDep = Annotated[NcService, _part("nc")]
 ProgramsDep = Annotated[ProgramService, _part("programs")]
 PlcDep = Annotated[PlcSimulator, _part("plc")]
+ProbeTestDep = Annotated[ProbeTestService, _part("probe_test")]

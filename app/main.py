@@ -48,6 +48,7 @@ from app.services import (
 )
 from app.services.measuring import MeasuringEnv
 from app.services.plc import PlcSimulator
+from app.services.probe_test import ProbeTestService
 from app.services.scenarios import read_scenario
 from app.web import web_router
 from app.web.language import LanguageMiddleware
@@ -77,6 +78,7 @@ def build_services(settings: Settings, scenario: Scenario | LatheScenario) -> Se
     machine.mode_source = lambda: services.nc.mode
     machine.on_discard(services.workflow.discard_points)
     services.plc = PlcSimulator(lambda: services.workflow)
+    services.probe_test = ProbeTestService(machine)
     return services
 
 

@@ -17,6 +17,7 @@ from .memories import MemoryService
 from .nc import NcService, ProgramService
 from .offsets import OffsetService
 from .plc import PlcSimulator
+from .probe_test import ProbeTestService
 from .probes import ProbeService, ToolProbeService
 from .settings import SettingsService
 from .tools import ToolService
@@ -37,6 +38,7 @@ class Services:
     plc: PlcSimulator | None = None
     nc: NcService | None = None
     programs: ProgramService | None = None
+    probe_test: ProbeTestService | None = None
 
 
 __all__ = ["LogService", "MachineService", "MemoryService", "NcService", "OffsetService", "ProbeService", "ProgramService",
