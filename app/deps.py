@@ -14,6 +14,7 @@ from app.services import (
     OffsetService,
     ProbeService,
     ProgramService,
+    ResultsService,
     Services,
     SettingsService,
     ToolProbeService,
@@ -51,3 +52,4 @@ NcDep = Annotated[NcService, _part("nc")]
 ProgramsDep = Annotated[ProgramService, _part("programs")]
 PlcDep = Annotated[PlcSimulator, _part("plc")]
 ProbeTestDep = Annotated[ProbeTestService, _part("probe_test")]
+ResultsDep = Annotated[ResultsService, _part("results")]

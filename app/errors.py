@@ -20,13 +20,18 @@ log = logging.getLogger(__name__)
 
 
 class HmiError(Exception):
+    """``extra``: machine-readable fields beside code/message/field in the envelope (e.g. the
+    running ``program`` of a 409 ``mode``)."""
+
     status = 400
     code = "bad_request"
 
-    def __init__(self, message: str, field: str | None = None, code: str | None = None):
+    def __init__(self, message: str, field: str | None = None, code: str | None = None,
+                 extra: dict | None = None):
         super().__init__(message)
         self.message = message
         self.field = field
+        self.extra = dict(extra or {})
         if code:
             self.code = code
 
@@ -48,6 +53,18 @@ class ConflictError(HmiError):
 
 class BusyError(ConflictError):
     code = "busy"
+
+
+class ModeError(ConflictError):
+    """Refused by the channel's mode group (issue 24 §4): a program runs in MDA/AUTO, or a JOG
+    measurement runs; ``extra`` names what runs (``mode``, ``program``)."""
+
+    code = "mode"
+
+
+class TooLarge(HmiError):
+    status = 413
+    code = "program_too_large"
 
 
 class WorkflowError(HmiError):
@@ -93,7 +110,12 @@ def _validation_message(err: dict) -> str:
 def install_handlers(app: FastAPI) -> None:
     @app.exception_handler(HmiError)
     async def _hmi_error(_: Request, exc: HmiError):
-        return error_response(exc.status, exc.code, exc.message, exc.field)
+        response = error_response(exc.status, exc.code, exc.message, exc.field)
+        if exc.extra:
+            body = envelope(exc.code, exc.message, exc.field)
+            body["error"].update({k: v for k, v in exc.extra.items() if k not in body["error"]})
+            response = JSONResponse(body, status_code=exc.status)
+        return response
 
     @app.exception_handler(MeasuringError)
     async def _measuring_error(_: Request, exc: MeasuringError):

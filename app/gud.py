@@ -129,6 +129,11 @@ class GudSettings(BaseModel):
         "auto", "-", "Language of the screens (auto = the browser's)", GENERAL)
     units: Literal["mm", "inch"] = _f("mm", "-", "Units of the screens (storage and API stay mm)", GENERAL)
 
+    # --- results (design.md §10.3, docs/results.md) ---------------------------------------------
+    verdict_rule: Literal["material", "scrap"] = _f(
+        "material", "-", "Out of tolerance: rework when material is left over, else scrap (scrap = always scrap)",
+        GENERAL)
+
     @model_validator(mode="before")
     @classmethod
     def _inch_display_follows_units(cls, data):

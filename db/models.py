@@ -215,6 +215,7 @@ class MeasurementLog(Base):
     correction: Mapped[Any] = mapped_column(NullableJSON, nullable=True)
     program: Mapped[str | None] = mapped_column(String(64), nullable=True)   # part program (NC cycle), else None
     block: Mapped[str | None] = mapped_column(String(200), nullable=True)    # the block that called the cycle
+    part_id: Mapped[int | None] = mapped_column(ForeignKey("parts.id"), nullable=True)   # the job's part (§10.3)
 
 
 class Program(Base):
@@ -226,3 +227,42 @@ class Program(Base):
     text: Mapped[str] = mapped_column(String)
     created_at: Mapped[str] = mapped_column(String(40))      # UTC ISO 8601
     updated_at: Mapped[str] = mapped_column(String(40))
+
+
+class Part(Base):
+    """One measured part of a job (design.md §10.3): part number, order, serial, who, which program."""
+
+    __tablename__ = "parts"
+    __table_args__ = (Index("ix_parts_part_number_id", "part_number", "id"),)
+
+    id: Mapped[int] = mapped_column(primary_key=True)
+    part_number: Mapped[str] = mapped_column(String(64))
+    order: Mapped[str | None] = mapped_column(String(64))
+    serial: Mapped[str | None] = mapped_column(String(64))
+    operator: Mapped[str | None] = mapped_column(String(64))
+    program: Mapped[str | None] = mapped_column(String(64))
+    started: Mapped[str] = mapped_column(String(40))                  # UTC ISO 8601
+
+
+class Characteristic(Base):
+    """One measured value of a part with its band and verdict (design.md §10.3)."""
+
+    __tablename__ = "characteristics"
+    __table_args__ = (Index("ix_characteristics_part_id", "part_id"),
+                      Index("ix_characteristics_name", "name"),
+                      CheckConstraint("verdict IN ('ok', 'rework', 'scrap', 'not_decidable')",
+                                      name="ck_characteristics_verdict"))
+
+    id: Mapped[int] = mapped_column(primary_key=True)
+    part_id: Mapped[int] = mapped_column(ForeignKey("parts.id", ondelete="CASCADE"))
+    log_id: Mapped[int | None] = mapped_column(ForeignKey("measurement_log.id"), nullable=True)
+    time: Mapped[str] = mapped_column(String(40))
+    name: Mapped[str] = mapped_column(String(80))
+    nominal: Mapped[float | None] = mapped_column(Float)
+    upper: Mapped[float | None] = mapped_column(Float)               # absolute limits (nominal + _TUL)
+    lower: Mapped[float | None] = mapped_column(Float)
+    actual: Mapped[float | None] = mapped_column(Float)
+    deviation: Mapped[float | None] = mapped_column(Float)
+    verdict: Mapped[str] = mapped_column(String(16))
+    unit: Mapped[str] = mapped_column(String(8), default="mm")
+    compensation: Mapped[float | None] = mapped_column(Float)         # the tool offset written after it, if any

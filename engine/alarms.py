@@ -307,6 +307,10 @@ NO_MEASURING_PATH = _define(
 NC_VALUE_RANGE = _define(
     65103, "NC_VALUE_RANGE", "Programmed value out of range", "编程值超出范围",
     "Correct the value shown in the message (sign, integer, size or range).")
+NC_RUNAWAY = _define(
+    65104, "NC_RUNAWAY", "Program runaway stopped: loop limit or watchdog", "程序失控已停止：循环上限或看门狗",
+    "The program repeats a jump without end or computes too long without moving: correct the loop's "
+    "condition, then press Reset.")
 NC_INTERNAL = _define(
     65199, "NC_INTERNAL", "Internal error of the part-program interpreter", "零件程序解释器内部错误",
     "Note the block and the message, press Reset and report it.")
@@ -355,3 +359,39 @@ OFFSET_OPTION = _define(
 CONTROLLER_ERROR = _define(
     65200, "CONTROLLER_ERROR", "Controller error", "控制器故障",
     "The controller reported an error (its message is the alarm text): correct the cause, then press Reset.")
+
+# --- logging measuring results, CYCLE100..CYCLE118 (manual §7.1, §11; spec measuring-math §15) -----
+PROTOCOL_NO_FILE = _define(
+    61354, "PROTOCOL_NO_FILE", "No data block found for the log file", "未找到用于记录文件的数据块",
+    "Give the log file a name in _PROTNAME[1] before CYCLE100.")
+PROTOCOL_FILE_TYPE = _define(
+    61355, "PROTOCOL_FILE_TYPE", "Wrong data block type for the log file", "用于记录文件的错误数据块类型",
+    "Name the log file with letters, digits and _, starting with two letters or a letter and _.")
+PROTOCOL_JOB = _define(
+    61360, "PROTOCOL_JOB", "Log job not defined - continue with Reset", "未定义记录任务——按复位键继续",
+    "Switch logging on with CYCLE100 first, and call CYCLE105/CYCLE106 with a valid parameter.")
+PROTOCOL_VALUE = _define(
+    61361, "PROTOCOL_VALUE", "Variable cannot be logged", "不能记录变量",
+    "Log only _OVR[n], _OVI[n], R parameters, _TXT[n], _TIME, _AXIS, _AXIS1..3 or text in _PROTVAL[2..5].")
+PROTOCOL_COUNT = _define(
+    61362, "PROTOCOL_COUNT", "Number of values too large", "数量值过大",
+    "CYCLE118 formats at most 10 values: reduce its 4th parameter.")
+PROTOCOL_LINE_LONG = _define(
+    62307, "PROTOCOL_LINE_LONG", "Maximum number of characters per line exceeded", "超过每行的最大字符数",
+    "Raise the characters per line in _PROTFORM[1].")
+PROTOCOL_VARIABLE_WIDTH = _define(
+    62308, "PROTOCOL_VARIABLE_WIDTH", "Variable column width not possible", "可变栏宽不可实现",
+    "Give the column titles in _PROTVAL[0]; the log uses a fixed width of 12 characters meanwhile.")
+PROTOCOL_COLUMN_WIDTH = _define(
+    62309, "PROTOCOL_COLUMN_WIDTH", "Column width insufficient", "栏宽不足",
+    "Widen the columns in _PROTFORM[5] or, with variable widths, the titles in _PROTVAL[0].")
+PROTOCOL_LINE_LIMIT = _define(
+    62310, "PROTOCOL_LINE_LIMIT", "Max. characters per line limited to 200", "每行最大字符数被限制为每行200个字符",
+    "Set _PROTFORM[1] to at most 200.")
+# 65600..65619: this product's numbers for the manual's messages that have none (manual §7.1.2)
+PROTOCOL_NEW_NAME = _define(
+    65600, "PROTOCOL_NEW_NAME", "Please give a new log name", "请给定新的记录名称",
+    "The log file and its 9 continuation files are full: set a new name in _PROTNAME[1] and start again.")
+PROTOCOL_CONTINUED = _define(
+    65601, "PROTOCOL_CONTINUED", "New log file created", "已编制新的记录数据",
+    "Informational: the log goes on in a continuation file (name with _ appended).")

@@ -175,12 +175,17 @@ def sphere_program(params: dict[str, Any], start: FloatArray, ctx: PlanContext, 
             return plane.to_xyz(np.array([a, o, p]))
 
         def go(target: FloatArray, what: str, safe: float = safe) -> Program[None]:
-            """Up to the safe height, across, down to ``target`` (ball centre)."""
+            """Up to the safe height, across, down to ``target`` (ball centre).
+
+            The crossing is at the safe height also when the probe already stands there (a start
+            at or above the safe height): a diagonal from there down to an equator point can cut
+            through the sphere (issue 24)."""
             here = plane.to_aop(m.pos + m.ball_offset)
             ta, to, tp = plane.to_aop(target)
-            if here[2] < safe - 1e-9 and not (abs(here[0] - ta) < 1e-9 and abs(here[1] - to) < 1e-9):
-                yield from m.to_ball(at(here[0], here[1], safe), f"{what} up")
-                yield from m.to_ball(at(ta, to, safe), f"{what} across")
+            if not (abs(here[0] - ta) < 1e-9 and abs(here[1] - to) < 1e-9):
+                if here[2] < safe - 1e-9:
+                    yield from m.to_ball(at(here[0], here[1], safe), f"{what} up")
+                yield from m.to_ball(at(ta, to, max(safe, float(here[2]))), f"{what} across")
             yield from m.to_ball(target, what)
 
         def touch(origin: FloatArray, d: FloatArray, what: str) -> Program[Touch]:

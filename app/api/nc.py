@@ -21,7 +21,7 @@ class RunBody(BaseModel):
         {"mda": "N10 G54 G0 X10 Y10\nN20 M30"}, {"program": "BORE1", "wait": False},
         {"mda": "G500 G90\n_MVAR=101 _SETVAL=20 _KNUM=1 _FA=5\nCYCLE977\nM30", "single_block": True}]})
     program: StrictStr | None = Field(None, description="the name of a stored program (AUTOMATIC)")
-    mda: StrictStr | None = Field(None, max_length=200_000, description="the text of an MDA program")
+    mda: StrictStr | None = Field(None, description="the text of an MDA program (at most 1 MiB: 413 above)")
     wait: StrictBool = Field(True, description="true: answer when the program has ended or stopped; "
                                                "false: 202 at once, GET /api/nc for the state")
     single_block: StrictBool = Field(False, description="single block: stop after every block "

@@ -15,12 +15,12 @@ class ProgramBody(BaseModel):
     model_config = ConfigDict(extra="forbid", json_schema_extra={"examples": [
         {"name": "BORE1", "text": "N10 G54 G0 X0 Y0\nN20 _MVAR=101 _SETVAL=20 _KNUM=1\nN30 CYCLE977\nN40 M30"}]})
     name: StrictStr = Field(description="letters, digits and _, starting with a letter (1..32)")
-    text: StrictStr = Field(max_length=200_000)
+    text: StrictStr = Field(description="the program text, at most 1 MiB (413 above)")
 
 
 class TextBody(BaseModel):
     model_config = ConfigDict(extra="forbid")
-    text: StrictStr = Field(max_length=200_000)
+    text: StrictStr = Field(description="the program text, at most 1 MiB (413 above)")
 
 
 @router.get("", name="api_programs")

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 import threading
+import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
@@ -155,6 +156,16 @@ class CycleContext:
     runtime: NcRuntime
     _interpreter: Interpreter = field(repr=False)
     _pos: n.Pos = field(repr=False)
+    # (name, index) of each argument written as a plain variable, else None: the 840D's
+    # call-by-reference parameters (CYCLE118 returns its text in its third argument)
+    arg_refs: tuple[tuple[str, tuple] | None, ...] = ()
+
+    def set_argument(self, number: int, value) -> None:
+        """Write ``value`` into the variable given as argument ``number`` (0-based)."""
+        ref = self.arg_refs[number] if number < len(self.arg_refs) else None
+        if ref is None:
+            raise self.alarm(alarms.NC_SYNTAX, f"{self.name}: argument {number + 1} must be a variable")
+        self.variables.set(ref[0], value, ref[1])
 
     @property
     def plane_axes(self) -> tuple[str, str, str]:
@@ -214,6 +225,11 @@ class CycleContext:
 
 _IDLE, _READY, _RUNNING, _STOPPED, _DONE, _ALARM = "idle", "ready", "running", "stopped", "done", "alarm"
 
+#: jumps one NC Start may execute: a loop beyond it is a runaway (alarm NC_RUNAWAY)
+MAX_JUMPS = 100_000
+#: seconds a run may compute without a command to the machine before the watchdog ends it
+WATCHDOG_S = 10.0
+
 
 class _Control:
     """How a block ends: go on, jump, stop (M0) or end the program."""
@@ -234,8 +250,12 @@ class Interpreter:
 
     def __init__(self, runtime: NcRuntime, variables: Variables | None = None,
                  cycles: Mapping[str, CycleHandler] | None = None, *, defaults: ModalState | None = None,
-                 on_block: Callable[[BlockRef], None] | None = None):
+                 on_block: Callable[[BlockRef], None] | None = None, max_jumps: int = MAX_JUMPS,
+                 watchdog_s: float = WATCHDOG_S):
         self.runtime = runtime
+        self.max_jumps = max_jumps
+        self.watchdog_s = watchdog_s
+        self._commands = 0                  # machine commands given (the watchdog's sign of life)
         self.variables = variables if variables is not None else Variables(axes=runtime.axes)
         self.cycles: Mapping[str, CycleHandler] = cycles if cycles is not None else {}
         self._defaults = defaults or ModalState()
@@ -361,6 +381,7 @@ class Interpreter:
             self._stop.clear()
         program = self._program
         last: BlockRef | None = None
+        watch = _Watchdog(self)
         try:
             while True:
                 if self._pc >= len(program.blocks):
@@ -377,6 +398,7 @@ class Interpreter:
                 last = ref
                 if control.kind == "end":
                     return self._finish(_DONE, control.reason, last)
+                watch.check(block, control)
                 if control.kind == "jump":
                     assert control.target is not None       # a jump names its block (_execute_block)
                     self._pc = control.target
@@ -434,6 +456,7 @@ class Interpreter:
 
     def _located(self, word, call):
         """Run ``call``; an ``NcRuntimeError`` becomes an alarm located at ``word``."""
+        self._commands += 1
         try:
             return call()
         except NcRuntimeError as e:
@@ -728,8 +751,11 @@ class Interpreter:
         handler = self.cycles.get(word.name)
         if handler is None:
             raise self._alarm(word, alarms.NC_NAME_UNKNOWN, f"{word.name} is not a cycle of this control")
+        ev = Evaluator(self.variables)
+        refs = tuple((a.name, ev.index(a, self.variables.definition(a.name))) if isinstance(a, n.Var) else None
+                     for a in word.args)
         ctx = CycleContext(word.name, args, BlockRef.of(block), self.variables, self._modal, self.runtime,
-                           self, word.pos)
+                           self, word.pos, refs)
         try:
             handler(ctx)
         except NcAlarm as e:
@@ -861,6 +887,32 @@ class Interpreter:
 
 
 # --- helpers -----------------------------------------------------------------------------------------
+
+class _Watchdog:
+    """The run-time bounds of one NC Start: at most ``max_jumps`` jumps, and no more than
+    ``watchdog_s`` seconds of blocks without a command to the machine (a computing loop)."""
+
+    def __init__(self, interp: Interpreter):
+        self._interp = interp
+        self._jumps = 0
+        self._commands = interp._commands
+        self._since = time.monotonic()
+
+    def check(self, block: n.Block, control: _Control) -> None:
+        interp = self._interp
+        if control.kind == "jump":
+            self._jumps += 1
+            if self._jumps > interp.max_jumps:
+                raise NcAlarm(f"the program jumped {interp.max_jumps} times without ending: a loop that never ends "
+                              "(check its condition)", block.line, block.pos.column, alarm=alarms.NC_RUNAWAY,
+                              block_text=block.text)
+        now = time.monotonic()
+        if interp._commands != self._commands:
+            self._commands, self._since = interp._commands, now
+        elif now - self._since > interp.watchdog_s:
+            raise NcAlarm(f"the program computed for {interp.watchdog_s:g} s without moving: watchdog",
+                          block.line, block.pos.column, alarm=alarms.NC_RUNAWAY, block_text=block.text)
+
 
 def _expressions(w) -> list[n.Expr]:
     if isinstance(w, n.Assign):

@@ -206,3 +206,5 @@ class Program:
     blocks: tuple[Block, ...]
     header: str | None = None                       # "%_N_TEST_MPF" line
     labels: dict[str, int] = field(default_factory=dict)   # label -> block index
+    #: jump target ("LABEL", "N10") -> block indices, ascending (parser.jump_targets); None: not indexed
+    targets: dict[str, tuple[int, ...]] | None = field(default=None, compare=False)

@@ -10,11 +10,12 @@ cycles are checked later against the variable store and the cycle registry
 
 from __future__ import annotations
 
+from bisect import bisect_left, bisect_right
 from functools import lru_cache
 from importlib import resources
 
-from lark import Lark, Token, Transformer, Tree, v_args
-from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken, VisitError
+from lark import Lark, Token, Transformer, Tree
+from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
 from engine import alarms
 
@@ -37,7 +38,7 @@ _TERMINAL_WORDS = {
     "BLOCKNO": "a block number", "CMP_OP": "a comparison", "ADD_OP": "'+' or '-'",
     "MUL_OP": "'*' or '/'",
 }
-_EXPRESSION_START = {"NUMBER", "INT_NUMBER", "NAME", "RPARAM", "STRING", "LPAR", "ADD_OP", "NOT",
+_EXPRESSION_START = {"NUMBER", "INT_NUMBER", "NAME", "RPARAM", "STRING", "LPAR", "ADD_OP", "NOT", "CONCAT",
                      "TRUE", "FALSE"}
 _UNSUPPORTED_ADDRESS = {
     "I": "circle and helix parameters (I, J, K) are not part of this control's language",
@@ -51,10 +52,24 @@ _STRUCTURED = {"ELSE", "ENDIF", "WHILE", "ENDWHILE", "FOR", "ENDFOR", "LOOP", "E
 TYPES = {"REAL", "INT", "BOOL", "STRING"}
 
 
+def _grammar() -> str:
+    return resources.files(__package__).joinpath("grammar.lark").read_text(encoding="utf-8")
+
+
 @lru_cache(maxsize=1)
 def _lark() -> Lark:
-    grammar = resources.files(__package__).joinpath("grammar.lark").read_text(encoding="utf-8")
-    return Lark(grammar, parser="lalr", lexer="contextual", propagate_positions=True,
+    """The parser that builds the nodes while it parses (no parse tree: ~3x faster on long
+    programs, bench/bench_nc_parse.py); ``_ToNodes`` keeps no state, so one instance serves
+    every thread."""
+    return Lark(_grammar(), parser="lalr", lexer="contextual", transformer=_ToNodes(),
+                maybe_placeholders=True, start="start")
+
+
+@lru_cache(maxsize=1)
+def _lark_tree() -> Lark:
+    """The same grammar building a parse tree: only to word the message of a syntax error (the
+    tokens before the error are on its stack)."""
+    return Lark(_grammar(), parser="lalr", lexer="contextual", propagate_positions=True,
                 maybe_placeholders=True, start="start")
 
 
@@ -73,7 +88,18 @@ def _number(text: str) -> int | float:
 
 
 class _ToNodes(Transformer):
-    """Tree -> nodes. Raises NcSyntaxError (wrapped by lark in VisitError) for invalid words."""
+    """The rules' callbacks -> nodes, called by the parser as it reduces. Raises NcSyntaxError
+    for invalid words. No state: the parser and this instance are shared between threads."""
+
+    # --- program and blocks -------------------------------------------------------------------
+    def start(self, items):
+        return list(items)
+
+    def header_block(self, items):
+        return ("HEADER", items[0])
+
+    def block(self, items):
+        return ("BLOCK", items)
 
     # --- expressions ------------------------------------------------------------------------
     def number(self, items):
@@ -109,9 +135,8 @@ class _ToNodes(Transformer):
     def exprs(self, items):
         return list(items)
 
-    def binop(self, items):
-        left, op, right = items
-        return n.Binary(op.value.upper(), left, right, _pos(op))
+    def chain(self, items):
+        return _climb(items)
 
     def unop(self, items):
         op, operand = items
@@ -126,10 +151,9 @@ class _ToNodes(Transformer):
         (tok,) = items
         return _address_word(tok)
 
-    @v_args(meta=True)
-    def assignment(self, meta, items):
+    def assignment(self, items):
         target, value = items
-        pos = n.Pos(meta.line, meta.column)
+        pos = target.pos
         values, is_set = ((value[1], True) if isinstance(value, tuple) else ((value,), False))
         name = target.name
         if not target.indices and name in _ASSIGN_WORDS:
@@ -207,6 +231,40 @@ class _ToNodes(Transformer):
         tok = items[0]
         _check_user_name(tok.value.upper(), _pos(tok))
         return ("LABEL", tok)
+
+
+#: how strongly an operator binds (840D: comparisons weakest, then << (text concatenation), OR,
+#: XOR, AND, + -, * / DIV MOD)
+_PRIORITY = {"CMP_OP": 1, "CONCAT": 1.5, "OR": 2, "XOR": 3, "AND": 4, "ADD_OP": 5, "MUL_OP": 6, "DIV": 6,
+             "MOD": 6}
+
+
+def _climb(items: list) -> n.Expr:
+    """``operand (operator operand)*`` -> the tree of binary operations: left-associative, by
+    ``_PRIORITY``; one comparison per chain (``a < b < c`` means nothing on the 840D)."""
+    operands: list[n.Expr] = [items[0]]
+    operators: list[Token] = []
+    comparison: Token | None = None
+
+    def reduce() -> None:
+        op = operators.pop()
+        right = operands.pop()
+        operands.append(n.Binary(op.value.upper(), operands.pop(), right, _pos(op)))
+
+    for k in range(1, len(items), 2):
+        op = items[k]
+        if op.type == "CMP_OP":
+            if comparison is not None:
+                raise NcSyntaxError(f"a second comparison {op.value} after {comparison.value}: compare two values "
+                                    "once and combine conditions with AND / OR", *_lc(_pos(op)))
+            comparison = op
+        while operators and _PRIORITY[operators[-1].type] >= _PRIORITY[op.type]:
+            reduce()
+        operators.append(op)
+        operands.append(items[k + 1])
+    while operators:
+        reduce()
+    return operands[0]
 
 
 def _lc(pos: n.Pos) -> tuple[int, int]:
@@ -331,26 +389,86 @@ def _syntax_error(e: UnexpectedInput, lines: list[str]) -> NcSyntaxError:
 
 # --- program ------------------------------------------------------------------------------------
 
+#: the longest block (840D: 512 characters per block incl. comment; Programming Manual
+#: Fundamentals, "Block format"): it also bounds the terms of an expression
+MAX_BLOCK_CHARS = 512
+#: the deepest nesting of parentheses and brackets in one block (the HMI's own bound: deeper
+#: nesting is no measuring program, and the evaluator recurses over it)
+MAX_NESTING = 32
+#: the largest program text in bytes (UTF-8); the API answers 413 above it
+MAX_PROGRAM_BYTES = 1024 * 1024
+
+
+def _scan_line(line: str, number: int) -> None:
+    """What the grammar cannot bound: the block's length, its nesting, and ASCII outside the
+    texts in quotes and the comment (a fullwidth digit is no digit of the NC: ``X１２``)."""
+    if len(line) > MAX_BLOCK_CHARS:
+        raise NcSyntaxError(f"the block has {len(line)} characters; a block holds at most {MAX_BLOCK_CHARS} "
+                            "(split it into several blocks)", number, MAX_BLOCK_CHARS + 1,
+                            block_text=line[:80])
+    if line.isascii() and "(" not in line and "[" not in line:
+        return
+    depth = 0
+    quoted = False
+    for column, ch in enumerate(line, start=1):
+        if ch == '"':
+            quoted = not quoted
+        elif quoted:
+            continue
+        elif ch == ";":
+            return
+        elif not ch.isascii():
+            raise NcSyntaxError(f"unexpected character '{ch}' (U+{ord(ch):04X}): the NC reads ASCII letters, "
+                                "digits and signs only (texts in quotes and comments may hold any)",
+                                number, column, block_text=line.strip())
+        elif ch in "([":
+            depth += 1
+            if depth > MAX_NESTING:
+                raise NcSyntaxError(f"the expression nests more than {MAX_NESTING} parentheses or brackets deep: "
+                                    "compute a part into an R parameter first", number, column,
+                                    block_text=line.strip())
+        elif ch in ")]":
+            depth -= 1
+
+
 def parse_program(text: str, name: str = "MDA") -> n.Program:
     """Parse and check ``text``; raises ``NcSyntaxError`` with line and column."""
     if not isinstance(text, str):
         raise TypeError("program text must be a str")
     source = text.replace("\r\n", "\n").replace("\r", "\n")
     lines = source.split("\n")
+    for number, line in enumerate(lines, start=1):
+        _scan_line(line, number)
     try:
-        tree = _lark().parse(source + "\n")
+        raw_blocks = _lark().parse(source + "\n")
     except UnexpectedInput as e:
-        raise _syntax_error(e, lines) from None
-    try:
-        raw_blocks = _ToNodes().transform(tree).children
-    except VisitError as e:
-        if isinstance(e.orig_exc, NcSyntaxError):
-            err = e.orig_exc
-            if err.line is not None and err.block_text is None and 0 < err.line <= len(lines):
-                err.block_text = lines[err.line - 1].strip()
-            raise err from None
+        raise _worded(e, lines) from None
+    except NcSyntaxError as err:
+        if err.line is not None and err.block_text is None and 0 < err.line <= len(lines):
+            err.block_text = lines[err.line - 1].strip()
         raise
     return _assemble(raw_blocks, source, lines, name)
+
+
+def _worded(e: UnexpectedInput, lines: list[str]) -> NcSyntaxError:
+    """The error in operator words: the line is parsed again into a tree, whose stack holds the
+    tokens before the error ("unexpected '=' after X10"); the grammar is one block per line."""
+    line = getattr(e, "line", None) or 1
+    if 0 < line <= len(lines):
+        try:
+            _lark_tree().parse("\n" * (line - 1) + lines[line - 1] + "\n")
+        except UnexpectedInput as again:
+            return _syntax_error(again, lines)
+    return _syntax_error(e, lines)
+
+
+def _block_start(items) -> tuple[int, int]:
+    first = items[0]
+    if isinstance(first, tuple):                # ("LABEL", token)
+        first = first[1]
+    if isinstance(first, Token):
+        return _lc(_pos(first))
+    return _lc(first[0].pos)                    # the words of the body
 
 
 def _assemble(raw_blocks, source: str, lines: list[str], name: str) -> n.Program:
@@ -358,20 +476,20 @@ def _assemble(raw_blocks, source: str, lines: list[str], name: str) -> n.Program
     header = None
     labels: dict[str, int] = {}
     seen_instruction = False
-    for tree in raw_blocks:
-        line = tree.meta.line
-        text = lines[line - 1].strip()
-        if tree.data == "header_block":
-            tok = tree.children[0]
+    for kind, items in raw_blocks:
+        if kind == "HEADER":
+            text = lines[items.line - 1].strip()
             if blocks or header is not None:
-                raise NcSyntaxError("the program name line (%...) must be the first line", line, tok.column,
+                raise NcSyntaxError("the program name line (%...) must be the first line", items.line, items.column,
                                     block_text=text)
-            header = tok.value
+            header = items.value
             continue
+        line, column = _block_start(items)
+        text = lines[line - 1].strip()
         number = None
         label = None
         words: list = []
-        for child in tree.children:
+        for child in items:
             if child is None:
                 continue
             if isinstance(child, Token) and child.type == "BLOCKNO":
@@ -384,7 +502,7 @@ def _assemble(raw_blocks, source: str, lines: list[str], name: str) -> n.Program
                 labels[label] = len(blocks)
             else:
                 words.extend(child)
-        block = n.Block(len(blocks), line, text, number, label, tuple(words), n.Pos(line, tree.meta.column))
+        block = n.Block(len(blocks), line, text, number, label, tuple(words), n.Pos(line, column))
         try:
             _check_block(block)
         except NcSyntaxError as err:
@@ -397,7 +515,7 @@ def _assemble(raw_blocks, source: str, lines: list[str], name: str) -> n.Program
         if words and not is_def:
             seen_instruction = True
         blocks.append(block)
-    program = n.Program(name, source, tuple(blocks), header, labels)
+    program = n.Program(name, source, tuple(blocks), header, labels, jump_targets(blocks))
     _check_jumps(program)
     return program
 
@@ -511,23 +629,32 @@ def _check_jumps(program: n.Program) -> None:
                                     alarm=alarms.NC_JUMP_TARGET, block_text=b.text)
 
 
-def find_jump(program: n.Program, from_index: int, goto: n.Goto) -> int | None:
-    """Index of the block ``goto`` jumps to from block ``from_index`` (840D search rules)."""
-    def matches(block: n.Block) -> bool:
-        if goto.target.startswith("N") and goto.target[1:].isdigit():
-            if block.number == int(goto.target[1:]):
-                return True
-        return block.label == goto.target
+def jump_targets(blocks) -> dict[str, tuple[int, ...]]:
+    """Block indices by what a jump may name: the label, and "N<number>" (block numbers may
+    repeat; the search direction picks one)."""
+    targets: dict[str, list[int]] = {}
+    for b in blocks:
+        if b.label is not None:
+            targets.setdefault(b.label, []).append(b.index)
+        if b.number is not None:
+            targets.setdefault(f"N{b.number}", []).append(b.index)
+    return {k: tuple(v) for k, v in targets.items()}
 
-    forward = range(from_index + 1, len(program.blocks))
-    backward = range(from_index - 1, -1, -1)
+
+def find_jump(program: n.Program, from_index: int, goto: n.Goto) -> int | None:
+    """Index of the block ``goto`` jumps to from block ``from_index`` (840D search rules:
+    GOTOF forward, GOTOB backward, GOTO forward first, then backward)."""
+    targets = program.targets if program.targets is not None else jump_targets(program.blocks)
+    found = targets.get(goto.target, ())
+    at = bisect_right(found, from_index)
+    forward = found[at] if at < len(found) else None
+    before = bisect_left(found, from_index)
+    backward = found[before - 1] if before > 0 else None
     if goto.direction == "GOTOF":
-        order = list(forward)
-    elif goto.direction == "GOTOB":
-        order = list(backward)
-    else:  # GOTO: forward first, then backward (840D)
-        order = list(forward) + list(backward)
-    return next((i for i in order if matches(program.blocks[i])), None)
+        return forward
+    if goto.direction == "GOTOB":
+        return backward
+    return forward if forward is not None else backward
 
 
 def parse_reference(text: str) -> n.Var:

@@ -490,6 +490,7 @@ def system_variables() -> list[VarDef]:
         sys("$AA_IW", "actual position, workpiece coordinates", axis_indexed=True),
         sys("$P_TOOLNO", "tool in the spindle (0 = none)", type="INT"),
         sys("$P_TOOL", "active D number", type="INT"),
+        sys("$PI", "the circle constant pi", default=math.pi),
     ]
 
 

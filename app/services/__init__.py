@@ -19,6 +19,7 @@ from .offsets import OffsetService
 from .plc import PlcSimulator
 from .probe_test import ProbeTestService
 from .probes import ProbeService, ToolProbeService
+from .results import ResultsService
 from .settings import SettingsService
 from .tools import ToolService
 
@@ -39,7 +40,8 @@ class Services:
     nc: NcService | None = None
     programs: ProgramService | None = None
     probe_test: ProbeTestService | None = None
+    results: ResultsService | None = None
 
 
-__all__ = ["LogService", "MachineService", "MemoryService", "NcService", "OffsetService", "ProbeService", "ProgramService",
+__all__ = ["LogService", "MachineService", "MemoryService", "NcService", "OffsetService", "ProbeService", "ProgramService", "ResultsService",
            "Services", "ToolProbeService", "SettingsService", "ToolService"]

@@ -12,6 +12,7 @@ from app.machine.protocol import Alarm, Machine
 from app.records import ToolData, frame_out_of_range, is_probe_tool
 from app.services.lathe_data import STATE_GROOVES
 from app.services.machine_service import MachineService
+from app.services.results import ResultsService
 from app.services.settings import SettingsService
 from app.workflow.context import (
     MeasuringContext,
@@ -76,6 +77,7 @@ class MeasuringEnv:
         self._settings = settings
         self._cache: tuple | None = None
         self._start_actor: Actor | None = None      # who pressed NC Start (for a measurement that runs on in a thread)
+        self.results: ResultsService | None = None   # links log entries to the job's part (design.md §10.3)
 
     @property
     def machine(self) -> Machine:
@@ -195,7 +197,7 @@ class MeasuringEnv:
                 stored_tool = unit.put_tool(tool_update[0], tool_update[1], source=source, detail=detail)
             if tool_probe_update is not None:
                 unit.put_tool_probe(tool_probe_update[0], tool_probe_update[1], source=source, detail=detail)
-            log_id = unit.add_log(entry)
+            log_id = self.results.add_log(unit, entry) if self.results is not None else unit.add_log(entry)
         if stored_offset is not None and not (probe_update or tool_update or tool_probe_update):
             self._written(generation, *stored_offset)
         if stored_offset is not None:          # the NC holds what was stored

@@ -28,15 +28,17 @@ from typing import Any
 
 import numpy as np
 
-from app.errors import ConflictError, HmiError, InvalidInput, NotFoundError
+from app.errors import ConflictError, HmiError, InvalidInput, NotFoundError, TooLarge
 from app.machine.protocol import MachineAlarm, MachineBusy
 from app.nc import Interpreter, NcRuntimeError, NcStateError, NcSyntaxError, VariableError, Variables
 from app.nc.cycles import measuring_cycles
 from app.nc.interpreter import CycleContext
+from app.nc.parser import MAX_PROGRAM_BYTES
 from app.nc.runtime import MeasureResult
 from app.services.machine_service import MachineService
 from app.services.measuring import MeasuringEnv
 from app.services.memories import MEMORY_COUNT
+from app.services.protocols import ProtocolFileStore
 from app.services.settings import SettingsService
 from app.workflow.service import WorkflowService
 from db import Database
@@ -241,6 +243,15 @@ def _json_ready(value):
 
 # --- the channel --------------------------------------------------------------------------------------
 
+def check_size(text: str, field: str) -> str:
+    """A program text the NC reads: at most ``MAX_PROGRAM_BYTES`` (UTF-8), else 413."""
+    size = len(text) if len(text) * 4 <= MAX_PROGRAM_BYTES else len(text.encode("utf-8"))
+    if size > MAX_PROGRAM_BYTES:
+        raise TooLarge(f"{field}: the program has {size} bytes; at most {MAX_PROGRAM_BYTES} "
+                       f"({MAX_PROGRAM_BYTES // 1024} KiB)", field=field)
+    return text
+
+
 class NcSyntaxInput(InvalidInput):
     """A program that cannot run as written: 422 naming line and column, nothing moved."""
 
@@ -263,6 +274,7 @@ class NcService:
         self.runtime = MachineRuntime(machine_service, db)
         self.variables = Variables(axes=machine_service.axes, backings={
             "_EV": _memory_backing(db, "EV"), "_MV": _memory_backing(db, "MV")})
+        self.protocol_files = ProtocolFileStore(db)     # CYCLE100..CYCLE106 write here (design.md §10.3)
         self.cycles = measuring_cycles(self)
         self.interpreter = Interpreter(self.runtime, self.variables, self.cycles)
         self._lock = threading.RLock()
@@ -377,6 +389,7 @@ class NcService:
             if program is not None:
                 self._load(self._program_text(program), program, "program")
             elif mda is not None:                 # always here: exactly one of them was given
+                check_size(mda, "mda")
                 self.mda_text = mda
                 self._load(mda, MDA, "mda")
             if single_block is not None:
@@ -531,9 +544,7 @@ class ProgramService:
     def _check_text(text) -> str:
         if not isinstance(text, str):
             raise InvalidInput("text: the program text", field="text")
-        if len(text) > 200_000:
-            raise InvalidInput("text: at most 200000 characters", field="text")
-        return text
+        return check_size(text, "text")
 
     def _with_check(self, program: dict) -> dict:
         return {**program, "syntax": self._nc.check(program["text"], program["name"]),

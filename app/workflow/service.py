@@ -169,8 +169,14 @@ class WorkflowService:
                 raise WorkflowError(400, "invalid_target" if field.startswith("target") else "invalid_param",
                                     text, field) from None
             return normalised
+        if "tolerance" in params and target != MEASURE_ONLY:    # measure only: the band of the verdict (§10.3)
+            raise WorkflowError(400, "invalid_param", "tolerance: only for a tool offset target or measure only",
+                                "tolerance")
         if "tolerance" in params:
-            raise WorkflowError(400, "invalid_param", "tolerance: only for a tool offset target", "tolerance")
+            try:
+                Tolerance.from_params(params.get("tolerance"), tolerance_defaults(ctx.settings))
+            except ValueError as exc:
+                raise WorkflowError(400, "invalid_param", str(exc), "tolerance") from None
         if not spec.corrects_zero_offset:
             return target
         if not isinstance(target, str) or (target != MEASURE_ONLY and target not in ctx.offset_names):

@@ -163,3 +163,42 @@ def test_reframed_target_reads_the_setpoints():
     m = np.array([g54.parent2child(true.child2parent(p)) for p in s])       # measured in the old G54
     new = reframed(cycle119(s, m), target_frame=g54, target_parent2bcs=Frame(), meas2bcs=g54)
     assert new.isclose(true, 1e-9)
+
+
+def clearance(a, b, centre) -> float:
+    """Smallest distance of the segment a→b from ``centre`` (analytic)."""
+    a, b, centre = (np.asarray(v, float) for v in (a, b, centre))
+    ab = b - a
+    t = 0.0 if not ab.any() else float(np.clip((centre - a) @ ab / (ab @ ab), 0.0, 1.0))
+    return float(np.linalg.norm(a + t * ab - centre))
+
+
+@pytest.mark.parametrize("angle", [False, True])
+@pytest.mark.parametrize("offset", [(0.0, 0.0), (30.0, -20.0), (-60.0, 10.0), (3.0, 0.5)])
+@pytest.mark.parametrize("height", [33.0, 38.0, 50.0, 60.0, 200.0])
+def test_sphere_positioning_never_enters_the_sphere(angle, offset, height):
+    """Issue 24 item 2: from any start above the sphere (also the start height at or above the
+    safe height, where the crossing used to be skipped), every positioning move of the ball stays
+    outside the sphere + ball radius; only the probing moves reach it."""
+    probe = ProbeRecord(ball_diameter=6.0)
+    true_c = np.array([100.1, 99.9, 100.05])
+    start = np.array([100.0 + offset[0], 100.0 + offset[1], 100.0 + height])
+    params = {"center": (100.0, 100.0, 100.0), "diameter": 50.0, "angle": angle, "start_angle": 10.0,
+              "increment": 120.0, "points": 3, "determine": True}
+    program = sphere_program(params, start, ctx_for(probe), "S")
+    contact = sphere_contact(true_c, 25.0)
+    pos, reply, moves = start, None, 0
+    try:
+        while True:
+            step = program.send(reply)
+            reply = None
+            if isinstance(step, MoveStep):
+                target = np.asarray(step.target, float)
+                assert clearance(pos, target, true_c) >= 25.0 + 3.0 - 1e-9, f"{step.label} cuts the sphere"
+                pos, moves = target, moves + 1
+            elif isinstance(step, ProbeStep):
+                pos = contact(pos, step)
+                reply = Latch(triggered=True, rec=pos.copy())
+    except StopIteration as done:
+        assert done.value.center == pytest.approx(true_c, abs=1e-9)
+    assert moves > 0

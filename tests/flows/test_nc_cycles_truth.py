@@ -341,6 +341,22 @@ def test_cycle997_sphere_centre(nc, mvar):
     assert nc.ovi()[2] == 997
 
 
+@pytest.mark.parametrize("mvar", [109, 1109, 1000109])
+@pytest.mark.parametrize(("dx", "dy", "above_top"), [(0.0, 0.0, 12.0), (0.4, -0.3, 1.0), (9.0, -6.0, 5.0)])
+def test_cycle997_from_a_start_just_above_the_sphere(nc, mvar, dx, dy, above_top):
+    """Issue 24: from a start a little above the sphere's top the cycle crosses at the safe height
+    and descends beside the sphere (it used to move diagonally into it: 61302); the simulator is
+    the judge, the result the hidden centre."""
+    c = SPHERES[0]
+    truth = nc.wcs_of(c)
+    q = (c[0] + 0.4, c[1] - 0.3, c[2] + 0.2)
+    z = c[2] + SPHERE_D / 2 + above_top + 2.0          # ball centre above the top by the ball radius + gap
+    nc.mda(approach(c[0] + dx, c[1] + dy, 60.0, safe=60.0) + f"Z{z}\n_MVAR={mvar} _SETVAL={SPHERE_D} "
+           f"_SETV[0]={q[0]} _SETV[1]={q[1]} _SETV[2]={q[2]} _STA1=15 _KNUM=0 _FA=3 _RF=800\nCYCLE997\nM30")
+    assert not nc.ok(nc.c.get("/api/machine"))["alarms"]
+    close("CYCLE997 sphere", nc.ovr()[5:8], truth)
+
+
 def test_cycle997_sphere_corrects_g54_in_three_axes(nc):
     c = SPHERES[1]
     q = (c[0] - 0.3, c[1] + 0.25, c[2] - 0.15)
