@@ -14,7 +14,20 @@ from pydantic import BaseModel, Field
 
 from app.access.deps import guard
 
-from . import access, data, events, lathe, machine, measure, nc, plc, probe_test, programs, results, setup_support
+from . import (
+    access,
+    data,
+    events,
+    lathe,
+    machine,
+    measure,
+    nc,
+    plc,
+    probe_test,
+    programs,
+    results,
+    setup_support,
+)
 
 
 def operation_id(route: APIRoute) -> str:
