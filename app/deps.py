@@ -14,6 +14,7 @@ from app.services import (
     OffsetService,
     ProbeService,
     ProgramService,
+    QualityService,
     ResultsService,
     Services,
     SettingsService,
@@ -53,3 +54,4 @@ ProgramsDep = Annotated[ProgramService, _part("programs")]
 PlcDep = Annotated[PlcSimulator, _part("plc")]
 ProbeTestDep = Annotated[ProbeTestService, _part("probe_test")]
 ResultsDep = Annotated[ResultsService, _part("results")]
+QualityDep = Annotated[QualityService, _part("quality")]

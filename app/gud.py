@@ -47,9 +47,14 @@ class GudSettings(BaseModel):
     override_mismatch: Literal["warn", "refuse"] = _f(
         "warn", "-", "Feed override differs from calibration", GENERAL)
     inch_display: bool = _f(False, "E_MESS_IS_METRIC", "Display in inch (storage stays mm)", GENERAL)  # = units
-    pretravel_frame: Literal["probe", "machine"] = _f(
-        "probe", "-", "Probe pre-travel turns with the spindle (probe) or stays with the machine axes",
-        GENERAL)
+    calibration_invalid: Literal["warn", "refuse"] = _f(
+        "warn", "-", "Measuring with an uncalibrated or invalid probe calibration", GENERAL)
+    calibration_max_age_h: float = _f(0.0, "-", "Probe calibration valid for (0 = no limit)", GENERAL, "h",
+                                      ge=0, le=100_000)
+    repeatability_limit: float = _f(0.002, "-", "Probe repeatability limit (2σ)", GENERAL, "mm", gt=0, le=1)
+    pretravel_frame: Literal["auto", "probe", "machine"] = _f(
+        "auto", "-", "Probe pre-travel turns with the spindle (probe) or stays with the machine axes "
+        "(auto = the ring calibration decides)", GENERAL)
 
     # --- workpiece measuring -------------------------------------------------------------------
     attempts: Literal[1, 5] = _f(1, "_JM_B[1]", "Measuring attempts", WORKPIECE)

@@ -41,6 +41,7 @@ from app.services import (
     OffsetService,
     ProbeService,
     ProgramService,
+    QualityService,
     ResultsService,
     Services,
     SettingsService,
@@ -74,6 +75,7 @@ def build_services(settings: Settings, scenario: Scenario | LatheScenario) -> Se
     services.memories = MemoryService(db)
     env = MeasuringEnv(db, machine, gud)
     services.results = env.results = ResultsService(db, gud, getattr(settings, "machine_name", None))
+    services.quality = QualityService(db, services.results)
     services.workflow = WorkflowService(env)
     services.nc = NcService(db, machine, env, gud)
     services.programs = ProgramService(db, services.nc)

@@ -88,6 +88,11 @@ class ProbeData(BaseModel):
     # the direction-dependent trigger map of a ring calibration with more than 4 directions
     # (engine.lobing.LobingMap.values_json, design.md §9.8); None: the 4 trigger values only
     lobing: dict | None = None
+    # what the ring calibration measured (issue [probe-health] item 5): the ball diameter from the
+    # chord sagittas (None: the chords could not tell, the nominal was used) and whether the
+    # pre-travel turns with the spindle ("probe") or stays with the machine axes ("machine")
+    measured_ball_diameter: StrictFloat | None = Field(None, gt=0, le=100)
+    pretravel_frame: Literal["probe", "machine"] | None = None
 
     # A probe's own physics bounds its data (measuring-math §5.1, measuring-math §5.2): the ball centre switches
     # within one ball diameter of the surface, the stylus is off the spindle axis by at most

@@ -395,3 +395,15 @@ PROTOCOL_NEW_NAME = _define(
 PROTOCOL_CONTINUED = _define(
     65601, "PROTOCOL_CONTINUED", "New log file created", "已编制新的记录数据",
     "Informational: the log goes on in a continuation file (name with _ appended).")
+
+# --- probe health (issue [probe-health], design.md §10.4): product-defined, 65120-65139 -----------
+PROBE_NOT_CALIBRATED = _define(
+    65120, "PROBE_NOT_CALIBRATED", "Probe not calibrated for this measurement", "测量头未针对此测量校准",
+    "Calibrate the probe: the length on a known surface, the radius in the ring gauge.")
+CALIBRATION_INVALID = _define(
+    65121, "CALIBRATION_INVALID", "Probe calibration no longer valid", "测量头校准已失效",
+    "Calibrate the probe again (the probe data screen says what made the calibration invalid).")
+REPEATABILITY_EXCEEDED = _define(
+    65122, "REPEATABILITY_EXCEEDED", "Probe repeatability above the limit", "测量头重复性超出极限",
+    "Clean the probe ball and the surface, check that the stylus is tight, then run the repeatability "
+    "check again.")

@@ -19,6 +19,7 @@ from .offsets import OffsetService
 from .plc import PlcSimulator
 from .probe_test import ProbeTestService
 from .probes import ProbeService, ToolProbeService
+from .quality import QualityService
 from .results import ResultsService
 from .settings import SettingsService
 from .tools import ToolService
@@ -41,7 +42,8 @@ class Services:
     programs: ProgramService | None = None
     probe_test: ProbeTestService | None = None
     results: ResultsService | None = None
+    quality: QualityService | None = None
 
 
-__all__ = ["LogService", "MachineService", "MemoryService", "NcService", "OffsetService", "ProbeService", "ProgramService", "ResultsService",
+__all__ = ["LogService", "MachineService", "MemoryService", "NcService", "OffsetService", "ProbeService", "ProgramService", "QualityService", "ResultsService",
            "Services", "ToolProbeService", "SettingsService", "ToolService"]

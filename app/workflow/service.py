@@ -16,6 +16,7 @@ import numpy as np
 
 from app.errors import WorkflowError
 from app.machine.protocol import MachineAlarm
+from app.workflow import probe_trust
 from app.workflow.context import (
     MEASURE_ONLY,
     MeasuringContext,
@@ -274,6 +275,10 @@ class WorkflowService:
         warnings = self._warnings(spec, ctx)
         if self._refuse_override(ctx):
             raise WorkflowError(409, "override_mismatch", warnings[-1])
+        distrust = probe_trust.findings(spec, session.params, n, ctx, self._env.machine)
+        if distrust and ctx.settings.calibration_invalid == "refuse":
+            raise WorkflowError(409, distrust[0].code, distrust[0].message)
+        warnings += [f.message for f in distrust]
         session.warnings = warnings
         session.running = True
         session.last_alarm = None
@@ -404,7 +409,7 @@ class WorkflowService:
                                 f"{alarms.NOT_CALIBRATED_IN_PLANE.text}: calibrated in {', '.join(planes)}, "
                                 f"measuring in {ctx.plane.name}: calibrate the probe in {ctx.plane.name}")
         angle = data.get("calibrated_spindle_angle")
-        if ctx.settings.pretravel_frame == "probe" and angle is not None:
+        if (data.get("pretravel_frame") or ctx.settings.pretravel_frame) != "machine" and angle is not None:
             off = abs((ctx.spindle_angle - float(angle) + 180.0) % 360.0 - 180.0)
             if off > 1e-6:
                 raise WorkflowError(409, "spindle_orientation",
@@ -418,8 +423,6 @@ class WorkflowService:
         probe = ctx.probe
         if not spec.needs_probe or probe is None:
             return warnings
-        if spec.name != "probe.radius" and not probe.calibrated_radius:
-            warnings.append("Probe not calibrated (radius): results carry its eccentricity and pre-travel")
         if (probe.calibration_override is not None
                 and abs(probe.calibration_override - ctx.feed_override) > 1e-9
                 and spec.category == Category.WORKPIECE):
