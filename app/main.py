@@ -81,6 +81,8 @@ def build_services(settings: Settings, scenario: Scenario | LatheScenario) -> Se
     services.programs = ProgramService(db, services.nc)
     machine.mode_source = lambda: services.nc.mode
     machine.on_discard(services.workflow.discard_points)
+    machine.on_reset(services.workflow.abort, services.workflow.wait_idle)   # one Reset (issue 24 §3)
+    machine.add_interlock(services.workflow.interlock)
     services.plc = PlcSimulator(lambda: services.workflow)
     services.probe_test = ProbeTestService(machine)
     return services

@@ -99,6 +99,10 @@ class MachineService:
         self._hold = HoldToRun(machine)
         self._frames: tuple[int, dict[str, Frame]] | None = None
         self._discard_listeners: list[Callable[[str], None]] = []
+        # one channel (issue 24 §3-4): what a Reset ends, what the mode group refuses, NC Stop's hold
+        self._reset_listeners: list[tuple[Callable[[], None], Callable[[], None]]] = []
+        self._interlocks: list[Callable[[str], None]] = []
+        self._held_override: float | None = None
         self.mode_source: Callable[[], str | None] | None = None   # the NC channel's mode (MDA/AUTO)
         self.changes = ChangeSignal()        # a change without motion (a probe deflected by hand): the live feed
         with db.unit(readonly=True) as unit:
@@ -164,6 +168,7 @@ class MachineService:
             "spindle_angle": float(st.spindle_angle),
             "alarms": alarms,
             "busy": bool(st.busy),
+            "feed_hold": self._held_override is not None,
             "program_state": program_state,
             "tool_axis": [float(v) for v in getattr(st, "tool_axis", (0.0, 0.0, 1.0))],
             "swivel": self.has_swivel(),
@@ -302,6 +307,7 @@ class MachineService:
             raise AlarmError(exc.alarm.code, exc.alarm.text) from None
 
     def _run(self, motion: Callable[[], MoveResult]) -> dict:
+        self.interlock("jog")
         self._ensure_idle()
         with self._machine_errors():
             result = motion()
@@ -323,6 +329,7 @@ class MachineService:
             raise InvalidInput("direction: must be -1 or +1", field="direction")
         feed = self._check_feed(feed)
         if not self._hold.renew(axis, direction):
+            self.interlock("jog")
             self._ensure_idle()
             with self._machine_errors():
                 self._hold.start(axis, direction, feed)
@@ -386,6 +393,7 @@ class MachineService:
         if not 0 < distance <= MAX_TRAVEL:
             raise InvalidInput(f"distance: must be > 0 and <= {MAX_TRAVEL:g}", field="distance")
         feed = self._check_feed(_finite(feed, "feed"))
+        self.interlock("probe")
         self._ensure_idle()
         with self._machine_errors():
             result = self._machine.probe(d, distance, feed)
@@ -399,15 +407,56 @@ class MachineService:
             "override": float(result.override),
         }
 
+    # --- one channel: Reset, the mode group, feed hold (issue 24 §3-4) ---------------------------
+    def on_reset(self, stop: Callable[[], None], wait: Callable[[], None]) -> None:
+        """A runner of motion (the NC channel, a JOG measurement) ends at a Reset: ``stop()`` tells
+        it (no new motion), ``wait()`` returns when it has ended."""
+        self._reset_listeners.append((stop, wait))
+
+    def add_interlock(self, check: Callable[[str], None]) -> None:
+        """``check(action)`` raises ``ModeError`` when ``action`` ("jog", "probe", "spindle",
+        "tool_change", "scenario", "measure", "nc_run") is refused while something runs."""
+        self._interlocks.append(check)
+
+    def interlock(self, action: str) -> None:
+        for check in self._interlocks:
+            check(action)
+
     def reset(self) -> dict:
+        """The channel's one Reset (panel key, ``/api/machine/reset``, ``/api/nc/reset``): the
+        runners are told to stop, the motion stops, the runners end (program reset to its
+        defaults, measurement aborted), feed hold ends, the resettable alarms are cleared."""
+        self._hold.release()
+        for stop, _wait in self._reset_listeners:
+            stop()
         self._machine.reset()
+        for _stop, wait in self._reset_listeners:
+            wait()
+        self.feed_hold(False)
+        self._machine.reset()                   # a motion begun meanwhile, the alarms of the abort
         return self.status()
+
+    def feed_hold(self, on: bool) -> None:
+        """NC Stop holds the axes where they are (override 0 %); NC Start lets them go on at the
+        override they had."""
+        with self._lock:
+            if on and self._held_override is None:
+                self._held_override = float(self._machine.status().feed_override)
+                self._machine.set_override(0.0)
+            elif not on and self._held_override is not None:
+                self._machine.set_override(self._held_override)
+                self._held_override = None
+
+    @property
+    def feed_held(self) -> bool:
+        return self._held_override is not None
 
     def spindle_position(self, angle: float) -> dict:
         """SPOS (deg, 0..360): on a lathe the clamped workpiece turns with the main spindle."""
         angle = _finite(angle, "angle")
         if not 0.0 <= angle <= 360.0:
             raise InvalidInput("angle: SPOS 0..360 degrees", field="angle")
+        self.interlock("spindle")
         self._ensure_idle()
         with self._machine_errors():
             self._machine.spindle_position(angle)
@@ -417,7 +466,11 @@ class MachineService:
         percent = _finite(percent, "feed")
         if not 0 <= percent <= 120:
             raise InvalidInput("feed: override must be 0..120 %", field="feed")
-        self._machine.set_override(percent)
+        with self._lock:
+            if self._held_override is not None:       # held: the new override acts at NC Start
+                self._held_override = float(percent)
+            else:
+                self._machine.set_override(percent)
         return self.status()
 
     # --- tools ------------------------------------------------------------------------------
@@ -461,6 +514,7 @@ class MachineService:
             if data is None:
                 raise NotFoundError(f"T{t} is not in the tool table", field="tool", code="unknown_tool")
             length = self.offset_length(data)
+        self.interlock("tool_change")
         self._ensure_idle()
         with self._db.unit() as unit:
             unit.set_state(STATE_TOOL, t)
@@ -549,6 +603,7 @@ class MachineService:
     def load_scenario(self, scenario: Scenario | LatheScenario, reset_data: bool = False) -> dict:
         """Reset the machine to ``scenario``; stored data stays unless ``reset_data``."""
         simulator = self._simulator("a scenario load")
+        self.interlock("scenario")
         self._ensure_idle()
         self._hold.release()
         with self._lock:

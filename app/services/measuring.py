@@ -85,6 +85,9 @@ class MeasuringEnv:
     def machine(self) -> Machine:
         return self._ms.machine
 
+    def interlock(self, action: str) -> None:
+        self._ms.interlock(action)
+
     def release_jog(self) -> None:
         """NC Start begins a measurement: forget a held jog, so that its dead-man watchdog cannot
         stop the measurement's motion (a late renewal may have restarted the jog)."""

@@ -224,7 +224,9 @@ def _values(task: str, params: dict, result: dict, zero_offset: bool) -> list[tu
         axis = params.get("axis")
         value = result["position"].get(axis)
         if isinstance(value, int | float):
-            out.append((f"position {axis}", "position", float(value), setpoint.get(axis)))
+            given = params.get("setpoint")            # a number (the edge's position) or {axis: value}
+            nominal = given if isinstance(given, int | float) and not isinstance(given, bool) else setpoint.get(axis)
+            out.append((f"position {axis}", "position", float(value), nominal))
     elif not zero_offset and task != "edge.set":
         for key in POSITIONS:
             point = result.get(key)

@@ -14,7 +14,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from app.errors import WorkflowError
+from app.errors import ModeError, WorkflowError
 from app.machine.protocol import MachineAlarm
 from app.workflow import probe_trust
 from app.workflow.context import (
@@ -46,6 +46,29 @@ class WorkflowService:
         self._tasks = tasks
         self._lock = threading.Lock()
         self._session: MeasureSession | None = None
+        self._reset = threading.Event()        # Reset: the running measurement starts no further step
+        self._runner: threading.Thread | None = None
+
+    # --- Reset and the mode group (MachineService.on_reset / add_interlock) --------------------
+    def abort(self) -> None:
+        """Reset, first step: the running measurement starts no further motion."""
+        if self._lock.locked():
+            self._reset.set()
+
+    def wait_idle(self, timeout: float = 2.0) -> None:
+        """Reset, second step: returns when no measurement runs (at most ``timeout``)."""
+        if self._runner is threading.current_thread():
+            return
+        if self._lock.acquire(timeout=timeout):
+            self._lock.release()
+
+    def interlock(self, action: str) -> None:
+        """While a JOG measurement runs, a program may not start (409 ``mode`` naming the task)."""
+        session = self._session
+        if action != "nc_run" or session is None or not session.running:
+            return
+        raise ModeError(f"the JOG measurement {session.task} is running: a program starts when it has ended "
+                        "(Reset ends it)", extra={"mode": "JOG", "program": session.task, "action": action})
 
     # --- sessions -----------------------------------------------------------------------
     @property
@@ -221,8 +244,11 @@ class WorkflowService:
         measurement runs in the background (the answer is 202-style: the session, ``running``
         true, its ``progress``); the session's ``answer``/``alarm`` tell how it ended."""
         session = self.get(session_id)
+        self._env.interlock("measure")
         if not self._lock.acquire(blocking=False):
             raise WorkflowError(409, "busy", "a measurement is already running")
+        self._reset.clear()
+        self._runner = threading.current_thread()
         try:
             spec, n, ctx = self._prepare_start(session, point)
         except BaseException:
@@ -237,6 +263,7 @@ class WorkflowService:
                 self._lock.release()
 
         def background() -> None:
+            self._runner = threading.current_thread()
             try:
                 self._run_point(session, spec, n, ctx)
             except WorkflowError:
@@ -455,6 +482,8 @@ class WorkflowService:
         session.progress = progress
 
         def execute(step):
+            if self._reset.is_set():
+                raise MotionAborted("Reset")
             current = session.progress
             assert current is not None, "set above for the run, cleared only after it (_run_point, _verify)"
             done = current["step"] + 1
