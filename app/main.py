@@ -50,6 +50,7 @@ from app.services import (
 )
 from app.services.measuring import MeasuringEnv
 from app.services.plc import PlcSimulator
+from app.services.probe_test import ProbeTestService
 from app.services.scenarios import read_scenario
 from app.web import web_router
 from app.web.language import LanguageMiddleware
@@ -83,6 +84,7 @@ def build_services(settings: Settings, scenario: Scenario | LatheScenario) -> Se
     machine.on_reset(services.workflow.abort, services.workflow.wait_idle)   # one Reset (issue 24 §3)
     machine.add_interlock(services.workflow.interlock)
     services.plc = PlcSimulator(lambda: services.workflow)
+    services.probe_test = ProbeTestService(machine)
     return services
 
 
