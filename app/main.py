@@ -51,6 +51,7 @@ from app.services import (
 from app.services.measuring import MeasuringEnv
 from app.services.plant import PlantService
 from app.services.plc import PlcSimulator
+from app.services.probe_test import ProbeTestService
 from app.services.scenarios import read_scenario
 from app.web import web_router
 from app.web.language import LanguageMiddleware
@@ -82,8 +83,11 @@ def build_services(settings: Settings, scenario: Scenario | LatheScenario) -> Se
     services.programs = ProgramService(db, services.nc)
     machine.mode_source = lambda: services.nc.mode
     machine.on_discard(services.workflow.discard_points)
+    machine.on_reset(services.workflow.abort, services.workflow.wait_idle)   # one Reset (issue 24 §3)
+    machine.add_interlock(services.workflow.interlock)
     services.plc = PlcSimulator(lambda: services.workflow)
     services.plant = PlantService(db, machine.status)
+    services.probe_test = ProbeTestService(machine)
     return services
 
 

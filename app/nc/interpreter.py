@@ -359,6 +359,10 @@ class Interpreter:
         """NC Stop (thread-safe): the running program stops before its next block; run() resumes."""
         self._stop.set()
 
+    def cancel_stop(self) -> None:
+        """NC Start after an NC Stop that the program has not reached yet: it goes on."""
+        self._stop.clear()
+
     def run(self) -> RunResult:
         """Run to the end, M0, a stop request or an alarm."""
         return self._go(single=False)

@@ -18,6 +18,7 @@ from .nc import NcService, ProgramService
 from .offsets import OffsetService
 from .plant import PlantService
 from .plc import PlcSimulator
+from .probe_test import ProbeTestService
 from .probes import ProbeService, ToolProbeService
 from .quality import QualityService
 from .results import ResultsService
@@ -40,6 +41,7 @@ class Services:
     plc: PlcSimulator | None = None
     nc: NcService | None = None
     programs: ProgramService | None = None
+    probe_test: ProbeTestService | None = None
     results: ResultsService | None = None
     quality: QualityService | None = None
     plant: PlantService | None = None
