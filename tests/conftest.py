@@ -9,6 +9,7 @@ import pytest
 from fastapi.testclient import TestClient
 from hmi_testdata import TEST_SCENARIO, test_scenario
 from live import CHROMIUM_ARGS, browser_tab, serve
+from pgcluster import database_settings
 
 # --- the database engine: SQLite by default, PostgreSQL with --db-engine=postgresql ------------
 
@@ -48,11 +49,6 @@ def database_target(request, tmp_path):
     if request.config.getoption("--db-engine") == "postgresql":
         return request.getfixturevalue("pg_cluster").new_database()
     return tmp_path / "data" / "hmi.db"
-
-
-def database_settings(target) -> dict:
-    """The Settings fields for ``database_target``: db_url for a URL, else db_path."""
-    return {"db_url": target} if isinstance(target, str) else {"db_path": target}
 
 
 @pytest.fixture

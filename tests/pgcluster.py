@@ -30,6 +30,11 @@ def pg_bin_dir() -> Path | None:
     return found[-1] / "bin" if found else None
 
 
+def database_settings(target: str | Path) -> dict[str, str | Path]:
+    """The ``app.config.Settings`` fields for a test's database: db_url for a URL, else db_path."""
+    return {"db_url": target} if isinstance(target, str) else {"db_path": target}
+
+
 def available() -> bool:
     return pg_bin_dir() is not None
 

@@ -4,6 +4,7 @@ the shared database with what it last reported. Runs on SQLite and on PostgreSQL
 from __future__ import annotations
 
 import pytest
+from pgcluster import database_settings
 
 from db import Database, acting_as
 from db.repository import Actor
@@ -11,7 +12,6 @@ from db.repository import Actor
 
 @pytest.fixture
 def plant_client(database_target, scenario_file):
-    from conftest import database_settings
     from fastapi.testclient import TestClient
 
     from app.config import Settings
