@@ -50,6 +50,7 @@ from app.services import (
 )
 from app.services.measuring import MeasuringEnv
 from app.services.plc import PlcSimulator
+from app.services.probe_test import ProbeTestService
 from app.services.scenarios import read_scenario
 from app.web import web_router
 from app.web.language import LanguageMiddleware
@@ -84,6 +85,7 @@ def build_services(settings: Settings, scenario: Scenario | LatheScenario) -> Se
     machine.add_interlock(services.workflow.interlock)
     machine.lock_source = lambda: services.nc.lock() or services.workflow.lock()
     services.plc = PlcSimulator(lambda: services.workflow)
+    services.probe_test = ProbeTestService(machine)
     return services
 
 

@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from app import checks
 from app.errors import ConflictError, HmiError, InvalidInput, ModeError, NotFoundError, TooLarge
 from app.machine.protocol import MachineAlarm, MachineBusy
 from app.nc import Interpreter, NcRuntimeError, NcStateError, NcSyntaxError, VariableError, Variables
@@ -35,9 +36,11 @@ from app.nc.cycles import measuring_cycles
 from app.nc.interpreter import CycleContext
 from app.nc.parser import MAX_PROGRAM_BYTES
 from app.nc.runtime import MeasureResult
+from app.nc.variables import InvalidValue
 from app.services.machine_service import MachineService
 from app.services.measuring import MeasuringEnv
 from app.services.memories import MEMORY_COUNT
+from app.services.memories import check_value as check_memory_value
 from app.services.protocols import ProtocolFileStore
 from app.services.settings import SettingsService
 from app.workflow.service import WorkflowService
@@ -548,8 +551,8 @@ class NcService:
     def write_variable(self, name: str, value) -> dict:
         if self.running:
             raise ConflictError("a program is running: write the variable when it has stopped", code="busy")
-        if isinstance(value, bool) or not isinstance(value, int | float | str):
-            raise InvalidInput("value: a number or a text", field="value")
+        if not isinstance(value, str):
+            value = checks.number(value, "value")       # no bool, no NaN, no 400-digit integer
         try:
             self.variables.write(name, value)
             return {name: _json_ready(self.variables.read(name))}
@@ -580,8 +583,12 @@ def _memory_backing(db: Database, kind: str):
         n = int(key) + 1
         if not 1 <= n <= MEMORY_COUNT:
             raise VariableError(f"_{kind}[{key}]: memory {n} is beyond the {MEMORY_COUNT} memories")
+        try:        # the range of /api/memories: a program cannot store what the API refuses
+            number = check_memory_value(value, f"_{kind}[{key}]")
+        except InvalidInput as exc:
+            raise InvalidValue(exc.message) from None
         with db.unit() as unit:
-            unit.put_memory(kind, n, float(value), source="nc")
+            unit.put_memory(kind, n, number, source="nc")
 
     return CallbackBacking(read, write)
 

@@ -307,6 +307,7 @@ class WorkflowService:
         if spec.needs_probe and ctx.probe is None:
             raise WorkflowError(409, "alarm", f"{alarms.PROBE_TYPE.number} {alarms.PROBE_TYPE.text}: the tool in "
                                               "the spindle is not a 3D probe (type 710); change to the probe first")
+        self._check_probe_ready(spec, ctx)
         self._check_probe_geometry(spec, ctx)
         warnings = self._warnings(spec, ctx)
         if self._refuse_override(ctx):
@@ -321,6 +322,26 @@ class WorkflowService:
         session.notice = None
         session.progress = {"point": n, "step": 0, "steps": None, "label": ""}
         return spec, n, ctx
+
+    def _check_probe_ready(self, spec: TaskSpec, ctx: MeasuringContext) -> None:
+        """A probe that cannot switch refuses NC Start with an alarm, before anything moves
+        (design.md §10.4): not the tool in the spindle, not armed (radio), deflected already.
+        A controller that cannot tell (state None) is trusted."""
+        status = self._env.machine.status()
+        which = spec.probe_used
+        state = status.probe if which == "workpiece" else status.tool_probe if which == "tool" else None
+        if state is None:
+            return
+        refusal = None
+        if which == "workpiece" and spec.needs_probe and ctx.probe is not None and not state.in_spindle:
+            refusal = alarms.PROBE_NOT_IN_SPINDLE
+        elif state.armed is False:
+            refusal = alarms.PROBE_NOT_ARMED if which == "workpiece" else alarms.TOOL_PROBE_NOT_ARMED
+        elif state.deflected:
+            refusal = alarms.PROBE_DEFLECTED if which == "workpiece" else alarms.TOOL_PROBE_DEFLECTED
+        if refusal is not None:
+            self._env.post_alarm(refusal.number, refusal.text)
+            raise WorkflowError(409, "alarm", f"{refusal.number} {refusal.text}: {refusal.remedy}")
 
     def _run_point(self, session: MeasureSession, spec: TaskSpec, n: int, ctx: MeasuringContext,
                    count_steps: bool = True) -> dict:
