@@ -85,6 +85,7 @@ def build_services(settings: Settings, scenario: Scenario | LatheScenario) -> Se
     machine.on_discard(services.workflow.discard_points)
     machine.on_reset(services.workflow.abort, services.workflow.wait_idle)   # one Reset (issue 24 §3)
     machine.add_interlock(services.workflow.interlock)
+    machine.lock_source = lambda: services.nc.lock() or services.workflow.lock()
     services.plc = PlcSimulator(lambda: services.workflow)
     services.plant = PlantService(db, machine.status)
     services.probe_test = ProbeTestService(machine)

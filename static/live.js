@@ -93,12 +93,36 @@
     document.addEventListener(name, function () { machineSig = sessionSig = null; });
   });
 
+  // the mode group (issue 24 §4): what runs (status.lock) greys out what it locks, and says why
+  function showLock(state) {
+    var lock = state.lock || null;
+    var program = lock && lock.mode !== "JOG" ? lock : null;
+    var mcp = document.getElementById("mcp");
+    if (mcp) {
+      mcp.classList.toggle("locked", !!program);
+      mcp.querySelectorAll(".key.jog").forEach(function (key) { key.disabled = !!program; });
+      var note = document.getElementById("mcp-lock");
+      if (note) {
+        note.hidden = !program;
+        note.querySelector(".lock-program").textContent = program ? program.mode + " " + program.program : "";
+      }
+    }
+    var start = document.getElementById("mda-start");
+    if (start) start.disabled = !!(lock && lock.mode === "JOG");
+    var jogNote = document.getElementById("mda-lock");
+    if (jogNote) {
+      jogNote.hidden = !(lock && lock.mode === "JOG");
+      jogNote.querySelector(".lock-program").textContent = lock && lock.mode === "JOG" ? lock.program : "";
+    }
+  }
+
   var source = new EventSource(url);
   source.addEventListener("open", function () { seen(); });
   source.addEventListener("machine", function (event) {
     seen();
     var state = JSON.parse(event.data);
     showPositions(state);
+    showLock(state);
     showProbes(state);
     var sig = machineSignature(state);
     machineSig = changed(machineSig, sig, "hmi-state");

@@ -102,6 +102,8 @@ class MachineService:
         self._interlocks: list[Callable[[str], None]] = []
         self._held_override: float | None = None
         self.mode_source: Callable[[], str | None] | None = None   # the NC channel's mode (MDA/AUTO)
+        # what runs and locks the rest ({"mode", "program"}: a program, a JOG measurement) or None
+        self.lock_source: Callable[[], dict | None] | None = None
         self.changes = ChangeSignal()        # a change without motion (a probe deflected by hand): the live feed
         with db.unit(readonly=True) as unit:
             active = unit.get_state(STATE_ACTIVE_OFFSET, G500)
@@ -167,6 +169,7 @@ class MachineService:
             "alarms": alarms,
             "busy": bool(st.busy),
             "feed_hold": self._held_override is not None,
+            "lock": self.lock_source() if self.lock_source else None,
             "program_state": program_state,
             "tool_axis": [float(v) for v in getattr(st, "tool_axis", (0.0, 0.0, 1.0))],
             "swivel": self.has_swivel(),

@@ -56,8 +56,7 @@ MDA = "MDA"
 #: how long a Reset waits for the program thread after its motion was aborted
 RESET_WAIT_S = 2.0
 #: what the mode group refuses from outside a running program (MachineService.interlock actions)
-_REFUSED = {"jog": "JOG motion", "probe": "a probing move", "spindle": "spindle positioning",
-            "tool_change": "a tool change", "scenario": "a scenario load", "measure": "NC Start of a JOG measurement"}
+LOCKED_BY_A_PROGRAM = ("jog", "probe", "spindle", "tool_change", "scenario", "measure")
 PROGRAM_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,31}$")
 
 
@@ -518,20 +517,22 @@ class NcService:
             self.interpreter.reset()
             self._source, self._crash, self._cycle_workflow = None, None, None
 
+    def lock(self) -> dict | None:
+        """``{"mode", "program"}`` while a program runs (the screens grey out what it locks)."""
+        if not self.running:
+            return None
+        program = self._source or MDA
+        return {"mode": MDA if program == MDA else "AUTO", "program": program}
+
     def interlock(self, action: str) -> None:
         """The mode group: while a program runs in MDA/AUTO, motion and changes from outside
         the program are refused (409 ``mode`` naming the program); the program's own thread
         passes."""
-        if not self.running or threading.current_thread() is self._thread:
+        lock = self.lock()
+        if lock is None or threading.current_thread() is self._thread or action not in LOCKED_BY_A_PROGRAM:
             return
-        what = _REFUSED.get(action)
-        if what is None:
-            return
-        program = self._source or MDA
-        mode = MDA if program == MDA else "AUTO"
-        name = "the MDA program" if program == MDA else f"program {program}"
-        raise ModeError(f"{name} is running in {mode}: {what} is locked until it ends (NC Stop holds it, "
-                        "Reset ends it)", field=None, extra={"mode": mode, "program": program, "action": action})
+        raise ModeError(f"Program {lock['program']} runs in {lock['mode']}: locked until the program ends "
+                        "(NC Stop holds it, Reset ends it)", extra={**lock, "action": action})
 
     def set_single_block(self, on: bool) -> dict:
         self.single_block = bool(on)

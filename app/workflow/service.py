@@ -62,13 +62,18 @@ class WorkflowService:
         if self._lock.acquire(timeout=timeout):
             self._lock.release()
 
+    def lock(self) -> dict | None:
+        """``{"mode": "JOG", "program": task}`` while a JOG measurement runs."""
+        session = self._session
+        return {"mode": "JOG", "program": session.task} if session is not None and session.running else None
+
     def interlock(self, action: str) -> None:
         """While a JOG measurement runs, a program may not start (409 ``mode`` naming the task)."""
-        session = self._session
-        if action != "nc_run" or session is None or not session.running:
+        lock = self.lock()
+        if action != "nc_run" or lock is None:
             return
-        raise ModeError(f"the JOG measurement {session.task} is running: a program starts when it has ended "
-                        "(Reset ends it)", extra={"mode": "JOG", "program": session.task, "action": action})
+        raise ModeError(f"The JOG measurement {lock['program']} runs: a program starts when it has ended "
+                        "(Reset ends it)", extra={**lock, "action": action})
 
     # --- sessions -----------------------------------------------------------------------
     @property
@@ -244,7 +249,12 @@ class WorkflowService:
         measurement runs in the background (the answer is 202-style: the session, ``running``
         true, its ``progress``); the session's ``answer``/``alarm`` tell how it ended."""
         session = self.get(session_id)
-        self._env.interlock("measure")
+        try:
+            self._env.interlock("measure")
+        except ModeError as exc:                # the screens show a WorkflowError's message
+            refusal = WorkflowError(409, "mode", exc.message)
+            refusal.extra = exc.extra
+            raise refusal from None
         if not self._lock.acquire(blocking=False):
             raise WorkflowError(409, "busy", "a measurement is already running")
         self._reset.clear()
