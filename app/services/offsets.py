@@ -41,9 +41,12 @@ class OffsetService:
             raise NotFoundError(f"unknown zero offset {name!r}", code="unknown_offset")
         return frame
 
-    def validate(self, name: str, changes: dict) -> dict:
-        """The stored frame of ``name`` with ``changes`` applied, fully checked; nothing is written."""
-        current = self.get(name)
+    def validate(self, name: str, changes: dict, unit=None) -> dict:
+        """The stored frame of ``name`` with ``changes`` applied, fully checked; nothing is written.
+        ``unit``: the writing unit to read the stored frame in (see ``put``)."""
+        current = self.get(name) if unit is None else unit.get_offset(name)
+        if current is None:
+            raise NotFoundError(f"unknown zero offset {name!r}", code="unknown_offset")
         if not isinstance(changes, dict):
             raise InvalidInput("frame must be an object with trans, fine, rot")
         unknown = sorted(set(changes) - set(FRAME_PARTS))
@@ -69,9 +72,11 @@ class OffsetService:
         return frame
 
     def put(self, name: str, changes: dict, source: str = "api", detail: dict | None = None) -> dict:
-        frame = self.validate(name, changes)
-        self._machine.check_holds(name, frame)
+        # read, merge and write in one writing unit: a concurrent change of another component (this
+        # or another HMI process) is not overwritten by the value read before it (design.md §10.5)
         with self._db.unit() as unit:
+            frame = self.validate(name, changes, unit)
+            self._machine.check_holds(name, frame)
             _before, after = unit.put_offset(name, frame, source=source, detail=detail)
         self._machine.write_offset(name, after)          # the NC holds what was stored
         if name.startswith("BASIC") or name == self._machine.active_offset:

@@ -33,16 +33,13 @@ class SettingsService:
     def __init__(self, db: Database):
         self._db = db
         self._lock = threading.Lock()
-        self._cached: GudSettings | None = None
+        # (write count, settings): read again once any process wrote (Database.generation)
+        self._cached: tuple[int, GudSettings] | None = None
 
     def get(self) -> GudSettings:
         """Stored values over the defaults; unknown or stale stored keys are ignored."""
         with self._lock:
-            if self._cached is None:
-                with self._db.unit(readonly=True) as unit:
-                    stored = unit.get_settings()
-                self._cached = _lenient(stored)
-            return self._cached
+            return self.get_unlocked()
 
     def validate(self, values: dict) -> GudSettings:
         """Current settings with ``values`` applied; InvalidInput names the first bad field."""
@@ -70,25 +67,38 @@ class SettingsService:
         return settings, {}
 
     def put(self, values: dict, source: str = "api") -> GudSettings:
-        """Audited (kind "settings"): the keys that changed, before and after."""
-        settings = self.validate(values)
+        """Audited (kind "settings"): the keys that changed, before and after. The stored values
+        are read, merged and written in one writing unit: a concurrent change of other keys (this
+        or another HMI process) is kept (design.md §10.5)."""
+        self.validate(values)                      # a bad value: refused before anything is locked
         with self._lock:
-            old = self.get_unlocked().model_dump()
-            new = settings.model_dump()
-            changed = sorted(k for k in new if new[k] != old.get(k))
             with self._db.unit() as unit:
+                old = _lenient(unit.get_settings()).model_dump()
+                settings = self._merged(old, values)
+                new = settings.model_dump()
+                changed = sorted(k for k in new if new[k] != old.get(k))
                 unit.put_settings(new)
                 if changed:
                     unit.add_audit("settings", "settings", {k: old.get(k) for k in changed},
                                    {k: new[k] for k in changed}, source)
-            self._cached = settings
+            self._cached = None
+        return settings
+
+    def _merged(self, current: dict, values: dict) -> GudSettings:
+        merged = {**current, **legacy_units(values, current)}
+        try:
+            settings = GudSettings.model_validate(merged)
+        except ValidationError as error:
+            raise_invalid(error)
+        self._check_wo(settings)
         return settings
 
     def get_unlocked(self) -> GudSettings:
-        if self._cached is None:
+        generation = self._db.generation           # before the read: a later write reads again
+        if self._cached is None or self._cached[0] != generation:
             with self._db.unit(readonly=True) as unit:
-                self._cached = _lenient(unit.get_settings())
-        return self._cached
+                self._cached = (generation, _lenient(unit.get_settings()))
+        return self._cached[1]
 
     def changes_levels(self, values) -> bool:
         """``values`` change the access-level table (a ``level_*`` setting)."""

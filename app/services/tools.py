@@ -38,14 +38,18 @@ class ToolService:
             raise NotFoundError(f"T{t} is not in the tool table", code="unknown_tool")
         return data
 
-    def validate(self, t: int, changes: dict) -> dict:
-        """Stored tool ``t`` (or a new one) with ``changes`` applied, checked; nothing is written."""
+    def validate(self, t: int, changes: dict, unit=None) -> dict:
+        """Stored tool ``t`` (or a new one) with ``changes`` applied, checked; nothing is written.
+        ``unit``: the writing unit to read the stored tool in (see ``put``)."""
         t = self.check_number(t)
         if not isinstance(changes, dict):
             raise InvalidInput("tool data must be an object")
         if "t" in changes and changes["t"] != t:
             raise InvalidInput(f"t: body says {changes['t']!r} but the path says {t}", field="t")
-        with self._db.unit(readonly=True) as unit:
+        if unit is None:
+            with self._db.unit(readonly=True) as reader:
+                current = reader.get_tool(t) or {"t": t}
+        else:
             current = unit.get_tool(t) or {"t": t}
         merged = {**current, **changes, "t": t}
         if isinstance(changes.get("wear"), dict):
@@ -57,8 +61,10 @@ class ToolService:
 
     def put(self, t: int, changes: dict, source: str = "api") -> dict:
         """Audited (kind "tool", item "T<t>", ``source``)."""
-        data = self.validate(t, changes)
+        # read, merge and write in one writing unit: a concurrent change of another field (this or
+        # another HMI process) is not overwritten by the value read before it (design.md §10.5)
         with self._db.unit() as unit:
+            data = self.validate(t, changes, unit)
             stored = unit.put_tool(data["t"], data, source=source)
         self._stored(stored)
         return stored
