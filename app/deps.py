@@ -22,6 +22,7 @@ from app.services import (
     ToolService,
 )
 from app.services.plc import PlcSimulator
+from app.services.probe_test import ProbeTestService
 from app.workflow.service import WorkflowService
 
 
@@ -51,5 +52,6 @@ WorkflowDep = Annotated[WorkflowService, _part("workflow")]
 NcDep = Annotated[NcService, _part("nc")]
 ProgramsDep = Annotated[ProgramService, _part("programs")]
 PlcDep = Annotated[PlcSimulator, _part("plc")]
+ProbeTestDep = Annotated[ProbeTestService, _part("probe_test")]
 ResultsDep = Annotated[ResultsService, _part("results")]
 QualityDep = Annotated[QualityService, _part("quality")]

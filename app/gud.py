@@ -34,7 +34,9 @@ def _level(function: str) -> Any:  # what pydantic's Field returns: the default,
 
 
 class GudSettings(BaseModel):
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, validate_assignment=True)
+    # strict (issue 25): a JSON true is no feed of 1 mm/min, the text "12" no number; the settings
+    # screen turns its typed text into numbers first (app.web.settings.parse_form)
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, validate_assignment=True, strict=True)
 
     # --- general (_JM_I, _JM_B, _CBIT) -------------------------------------------------------
     plane: Literal["G17", "G18", "G19"] = _f("G17", "_JM_I[3]", "Working plane for measuring", GENERAL)
@@ -147,6 +149,14 @@ class GudSettings(BaseModel):
         if isinstance(data, dict) and "units" in data:
             data = {**data, "inch_display": data["units"] == "inch"}
         return data
+
+    @field_validator("*", mode="before")
+    @classmethod
+    def _no_bool_for_numbers(cls, value, info):
+        """``true`` is no 1 (a strict Literal[1, 5] still takes it, since True == 1)."""
+        if isinstance(value, bool) and cls.model_fields[info.field_name].annotation is not bool:
+            raise ValueError("must be a number, not true/false")
+        return value
 
     @field_validator("measuring_wo")
     @classmethod

@@ -50,6 +50,7 @@ from app.services import (
 )
 from app.services.measuring import MeasuringEnv
 from app.services.plc import PlcSimulator
+from app.services.probe_test import ProbeTestService
 from app.services.scenarios import read_scenario
 from app.web import web_router
 from app.web.language import LanguageMiddleware
@@ -82,7 +83,9 @@ def build_services(settings: Settings, scenario: Scenario | LatheScenario) -> Se
     machine.on_discard(services.workflow.discard_points)
     machine.on_reset(services.workflow.abort, services.workflow.wait_idle)   # one Reset (issue 24 §3)
     machine.add_interlock(services.workflow.interlock)
+    machine.lock_source = lambda: services.nc.lock() or services.workflow.lock()
     services.plc = PlcSimulator(lambda: services.workflow)
+    services.probe_test = ProbeTestService(machine)
     return services
 
 

@@ -6,7 +6,6 @@ Validation models shared by the services (API/screen writes) and the measuring w
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from typing import Literal
 
@@ -21,6 +20,8 @@ from pydantic import (
     field_validator,
 )
 
+from app import checks
+from app.errors import InvalidInput
 from engine.lobing import lobing_map_from_json
 from engine.types import TRIGGER_KEYS
 
@@ -35,9 +36,10 @@ def frame_out_of_range(frame: Mapping) -> tuple[str, str] | None:
     for part in ("trans", "fine", "rot"):
         for axis, value in (frame.get(part) or {}).items():
             field = f"{part}.{axis}"
-            number = float(value)
-            if not math.isfinite(number):
-                return field, f"{field}: must be a finite number"
+            try:
+                number = checks.number(value, field)
+            except InvalidInput as exc:
+                return field, exc.message
             if part == "rot" and not abs(number) < 360.0:
                 return field, f"{field}: rotation must lie in (-360, 360) degrees"
             if abs(number) > MAX_TRANSLATION:

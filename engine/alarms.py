@@ -315,6 +315,24 @@ NC_INTERNAL = _define(
     65199, "NC_INTERNAL", "Internal error of the part-program interpreter", "零件程序解释器内部错误",
     "Note the block and the message, press Reset and report it.")
 
+# --- probe state at NC Start (design.md §10.4) ----------------------------------------------------
+# Product-defined (840D user alarm range): a measuring task starts only with a probe that can switch.
+PROBE_NOT_ARMED = _define(
+    65400, "PROBE_NOT_ARMED", "Probe not ready: it is not switched on", "测量头未就绪：未开启",
+    "Switch the probe on (radio probe: check or change its battery), press Reset, then NC Start again.")
+PROBE_DEFLECTED = _define(
+    65401, "PROBE_DEFLECTED", "Probe deflected before the start", "启动前测量头已偏转",
+    "Jog the probe clear of the surface and check that the stylus sits free, press Reset, then NC Start again.")
+PROBE_NOT_IN_SPINDLE = _define(
+    65402, "PROBE_NOT_IN_SPINDLE", "The probe is not the tool in the spindle", "测量头不是主轴中的刀具",
+    "Load the workpiece probe into the spindle (tool change), press Reset, then NC Start again.")
+TOOL_PROBE_NOT_ARMED = _define(
+    65403, "TOOL_PROBE_NOT_ARMED", "Tool probe not ready: it is not switched on", "刀具测量头未就绪：未开启",
+    "Switch the tool probe on (radio probe: check or change its battery), press Reset, then NC Start again.")
+TOOL_PROBE_DEFLECTED = _define(
+    65404, "TOOL_PROBE_DEFLECTED", "Tool probe deflected before the start", "启动前刀具测量头已偏转",
+    "Move the tool clear of the tool probe and check that its disc sits free, press Reset, then NC Start again.")
+
 # --- turning cycles: alarms of spec/turning.md §8 the catalogue lacked (seed 001 [L28123–L28133]) ---
 TOOL_ENVIRONMENT = _define(
     61405, "TOOL_ENVIRONMENT", "Tool environment in _TENV does not exist", "_TENV中刀具范围不存在",

@@ -28,6 +28,6 @@ async def events(request: Request, machine: MachineDep, workflow: WorkflowDep,
         current = workflow.session
         return None if current is None else current.to_api()
 
-    feed = LiveFeed(machine.status, session)
+    feed = LiveFeed(machine.status, session, machine.changes)
     return EventSourceResponse(feed.events(limit, request.is_disconnected), ping=15,
                                headers={"Cache-Control": "no-store", "X-Accel-Buffering": "no"})

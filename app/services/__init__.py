@@ -17,6 +17,7 @@ from .memories import MemoryService
 from .nc import NcService, ProgramService
 from .offsets import OffsetService
 from .plc import PlcSimulator
+from .probe_test import ProbeTestService
 from .probes import ProbeService, ToolProbeService
 from .quality import QualityService
 from .results import ResultsService
@@ -39,6 +40,7 @@ class Services:
     plc: PlcSimulator | None = None
     nc: NcService | None = None
     programs: ProgramService | None = None
+    probe_test: ProbeTestService | None = None
     results: ResultsService | None = None
     quality: QualityService | None = None
 

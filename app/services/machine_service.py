@@ -23,7 +23,6 @@ With a swivel head turned out of +Z the length goes along the machine's actual t
 
 from __future__ import annotations
 
-import math
 import threading
 import time
 from collections.abc import Callable, Mapping
@@ -33,6 +32,7 @@ from typing import overload
 
 import numpy as np
 
+from app import checks
 from app.errors import AlarmError, BusyError, ConflictError, InvalidInput, NotFoundError
 from app.machine.lathe_scenario import LatheScenario
 from app.machine.protocol import (
@@ -41,7 +41,9 @@ from app.machine.protocol import (
     Machine,
     MachineAlarm,
     MachineBusy,
+    MachineStatus,
     MoveResult,
+    ProbeState,
     SimulatorControl,
     SwivelHead,
 )
@@ -55,6 +57,7 @@ from engine.frames import G500, Frame, FrameChain, chain_of, is_basic
 from engine.planes import plane as plane_by_name
 
 from . import lathe_data
+from .live import ChangeSignal
 from .settings import SettingsService
 
 CHANNEL = "CHAN1"
@@ -65,9 +68,7 @@ STATE_TOOL = "tool"
 
 
 def _finite(value, field: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise InvalidInput(f"{field}: must be a finite number", field=field)
-    return float(value)
+    return checks.number(value, field)
 
 
 def alarm_dict(alarm: Alarm) -> dict:
@@ -101,6 +102,9 @@ class MachineService:
         self._interlocks: list[Callable[[str], None]] = []
         self._held_override: float | None = None
         self.mode_source: Callable[[], str | None] | None = None   # the NC channel's mode (MDA/AUTO)
+        # what runs and locks the rest ({"mode", "program"}: a program, a JOG measurement) or None
+        self.lock_source: Callable[[], dict | None] | None = None
+        self.changes = ChangeSignal()        # a change without motion (a probe deflected by hand): the live feed
         with db.unit(readonly=True) as unit:
             active = unit.get_state(STATE_ACTIVE_OFFSET, G500)
             tool = unit.get_state(STATE_TOOL, None)
@@ -165,12 +169,40 @@ class MachineService:
             "alarms": alarms,
             "busy": bool(st.busy),
             "feed_hold": self._held_override is not None,
+            "lock": self.lock_source() if self.lock_source else None,
             "program_state": program_state,
             "tool_axis": [float(v) for v in getattr(st, "tool_axis", (0.0, 0.0, 1.0))],
             "swivel": self.has_swivel(),
             "controller": self._machine.controller,
+            **self._probe_status(st),
             **(self._lathe_status(st) if self.is_lathe else {}),
         }
+
+    def probe_status(self) -> dict:
+        """``{"probe", "tool_probe"}`` of ``status()``, read alone (the probe test samples it)."""
+        return self._probe_status(self._machine.status())
+
+    def _probe_status(self, st: MachineStatus) -> dict:
+        """``probe`` and ``tool_probe`` (design.md §10.4); a controller that cannot tell its
+        probe's state shows only whether the probe is the tool in the spindle."""
+        probe = st.probe or ProbeState(in_spindle=st.tool is not None and st.tool == self._scenario.probe.t,
+                                       deflected=None)
+        tool_probe = None
+        if st.tool_probe is not None:
+            tool_probe = {k: v for k, v in st.tool_probe.to_api().items() if k != "in_spindle"}
+        return {"probe": probe.to_api(), "tool_probe": tool_probe}
+
+    def set_probe(self, which: str, deflect=None, battery=None, armed=None) -> dict:
+        """The operator's hand on a probe of the simulator (``POST /api/sim/probe``, design.md §10.4)."""
+        simulator = self._simulator("a hand on the probe")
+        try:
+            simulator.set_probe(which, deflect, battery, armed)
+        except ValueError as exc:
+            field = str(exc).partition(":")[0]
+            raise InvalidInput(str(exc), field=field if field in ("probe", "deflect", "battery", "armed")
+                               else None) from None
+        self.changes.notify()
+        return self.status()
 
     def _lathe_status(self, st) -> dict:
         l1, l2 = getattr(st, "tool_lengths", (0.0, 0.0))

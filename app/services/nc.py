@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from app import checks
 from app.errors import ConflictError, HmiError, InvalidInput, ModeError, NotFoundError, TooLarge
 from app.machine.protocol import MachineAlarm, MachineBusy
 from app.nc import Interpreter, NcRuntimeError, NcStateError, NcSyntaxError, VariableError, Variables
@@ -35,9 +36,11 @@ from app.nc.cycles import measuring_cycles
 from app.nc.interpreter import CycleContext
 from app.nc.parser import MAX_PROGRAM_BYTES
 from app.nc.runtime import MeasureResult
+from app.nc.variables import InvalidValue
 from app.services.machine_service import MachineService
 from app.services.measuring import MeasuringEnv
 from app.services.memories import MEMORY_COUNT
+from app.services.memories import check_value as check_memory_value
 from app.services.protocols import ProtocolFileStore
 from app.services.settings import SettingsService
 from app.workflow.service import WorkflowService
@@ -53,8 +56,7 @@ MDA = "MDA"
 #: how long a Reset waits for the program thread after its motion was aborted
 RESET_WAIT_S = 2.0
 #: what the mode group refuses from outside a running program (MachineService.interlock actions)
-_REFUSED = {"jog": "JOG motion", "probe": "a probing move", "spindle": "spindle positioning",
-            "tool_change": "a tool change", "scenario": "a scenario load", "measure": "NC Start of a JOG measurement"}
+LOCKED_BY_A_PROGRAM = ("jog", "probe", "spindle", "tool_change", "scenario", "measure")
 PROGRAM_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,31}$")
 
 
@@ -515,20 +517,22 @@ class NcService:
             self.interpreter.reset()
             self._source, self._crash, self._cycle_workflow = None, None, None
 
+    def lock(self) -> dict | None:
+        """``{"mode", "program"}`` while a program runs (the screens grey out what it locks)."""
+        if not self.running:
+            return None
+        program = self._source or MDA
+        return {"mode": MDA if program == MDA else "AUTO", "program": program}
+
     def interlock(self, action: str) -> None:
         """The mode group: while a program runs in MDA/AUTO, motion and changes from outside
         the program are refused (409 ``mode`` naming the program); the program's own thread
         passes."""
-        if not self.running or threading.current_thread() is self._thread:
+        lock = self.lock()
+        if lock is None or threading.current_thread() is self._thread or action not in LOCKED_BY_A_PROGRAM:
             return
-        what = _REFUSED.get(action)
-        if what is None:
-            return
-        program = self._source or MDA
-        mode = MDA if program == MDA else "AUTO"
-        name = "the MDA program" if program == MDA else f"program {program}"
-        raise ModeError(f"{name} is running in {mode}: {what} is locked until it ends (NC Stop holds it, "
-                        "Reset ends it)", field=None, extra={"mode": mode, "program": program, "action": action})
+        raise ModeError(f"Program {lock['program']} runs in {lock['mode']}: locked until the program ends "
+                        "(NC Stop holds it, Reset ends it)", extra={**lock, "action": action})
 
     def set_single_block(self, on: bool) -> dict:
         self.single_block = bool(on)
@@ -547,8 +551,8 @@ class NcService:
     def write_variable(self, name: str, value) -> dict:
         if self.running:
             raise ConflictError("a program is running: write the variable when it has stopped", code="busy")
-        if isinstance(value, bool) or not isinstance(value, int | float | str):
-            raise InvalidInput("value: a number or a text", field="value")
+        if not isinstance(value, str):
+            value = checks.number(value, "value")       # no bool, no NaN, no 400-digit integer
         try:
             self.variables.write(name, value)
             return {name: _json_ready(self.variables.read(name))}
@@ -579,8 +583,12 @@ def _memory_backing(db: Database, kind: str):
         n = int(key) + 1
         if not 1 <= n <= MEMORY_COUNT:
             raise VariableError(f"_{kind}[{key}]: memory {n} is beyond the {MEMORY_COUNT} memories")
+        try:        # the range of /api/memories: a program cannot store what the API refuses
+            number = check_memory_value(value, f"_{kind}[{key}]")
+        except InvalidInput as exc:
+            raise InvalidValue(exc.message) from None
         with db.unit() as unit:
-            unit.put_memory(kind, n, float(value), source="nc")
+            unit.put_memory(kind, n, number, source="nc")
 
     return CallbackBacking(read, write)
 

@@ -168,6 +168,12 @@ def _label_of(key: str, field_label) -> str:
 
 # the service messages (app/services, app/workflow, engine.params), most specific first
 message(r"(?P<field>[\w.+\-\[\]]+): '(?P<value>.*)' is not a number", N_("%(field)s: enter a number"))
+# the channel's mode group (app/services/nc.py, app/workflow/service.py)
+message(r"Program (?P<program>\S+) runs in (?P<mode>MDA|AUTO): locked until the program ends "
+        r"\(NC Stop holds it, Reset ends it\)",
+        N_("Program %(program)s runs in %(mode)s: locked until the program ends (NC Stop holds it, Reset ends it)"))
+message(r"The JOG measurement (?P<program>\S+) runs: a program starts when it has ended \(Reset ends it\)",
+        N_("The JOG measurement %(program)s runs: a program starts when it has ended (Reset ends it)"))
 message(r"(?P<field>[\w.+\-\[\]]+): must be a finite number", N_("%(field)s: enter a number"))
 message(r"(?P<field>[\w.+\-\[\]]+) must be a number, got .*", N_("%(field)s: enter a number"))
 message(r"(?P<field>[\w.+\-\[\]]+) must be a finite number, got .*", N_("%(field)s: enter a number"))

@@ -62,13 +62,18 @@ class WorkflowService:
         if self._lock.acquire(timeout=timeout):
             self._lock.release()
 
+    def lock(self) -> dict | None:
+        """``{"mode": "JOG", "program": task}`` while a JOG measurement runs."""
+        session = self._session
+        return {"mode": "JOG", "program": session.task} if session is not None and session.running else None
+
     def interlock(self, action: str) -> None:
         """While a JOG measurement runs, a program may not start (409 ``mode`` naming the task)."""
-        session = self._session
-        if action != "nc_run" or session is None or not session.running:
+        lock = self.lock()
+        if action != "nc_run" or lock is None:
             return
-        raise ModeError(f"the JOG measurement {session.task} is running: a program starts when it has ended "
-                        "(Reset ends it)", extra={"mode": "JOG", "program": session.task, "action": action})
+        raise ModeError(f"The JOG measurement {lock['program']} runs: a program starts when it has ended "
+                        "(Reset ends it)", extra={**lock, "action": action})
 
     # --- sessions -----------------------------------------------------------------------
     @property
@@ -244,7 +249,12 @@ class WorkflowService:
         measurement runs in the background (the answer is 202-style: the session, ``running``
         true, its ``progress``); the session's ``answer``/``alarm`` tell how it ended."""
         session = self.get(session_id)
-        self._env.interlock("measure")
+        try:
+            self._env.interlock("measure")
+        except ModeError as exc:                # the screens show a WorkflowError's message
+            refusal = WorkflowError(409, "mode", exc.message)
+            refusal.extra = exc.extra
+            raise refusal from None
         if not self._lock.acquire(blocking=False):
             raise WorkflowError(409, "busy", "a measurement is already running")
         self._reset.clear()
@@ -297,6 +307,7 @@ class WorkflowService:
         if spec.needs_probe and ctx.probe is None:
             raise WorkflowError(409, "alarm", f"{alarms.PROBE_TYPE.number} {alarms.PROBE_TYPE.text}: the tool in "
                                               "the spindle is not a 3D probe (type 710); change to the probe first")
+        self._check_probe_ready(spec, ctx)
         self._check_probe_geometry(spec, ctx)
         warnings = self._warnings(spec, ctx)
         if self._refuse_override(ctx):
@@ -311,6 +322,26 @@ class WorkflowService:
         session.notice = None
         session.progress = {"point": n, "step": 0, "steps": None, "label": ""}
         return spec, n, ctx
+
+    def _check_probe_ready(self, spec: TaskSpec, ctx: MeasuringContext) -> None:
+        """A probe that cannot switch refuses NC Start with an alarm, before anything moves
+        (design.md §10.4): not the tool in the spindle, not armed (radio), deflected already.
+        A controller that cannot tell (state None) is trusted."""
+        status = self._env.machine.status()
+        which = spec.probe_used
+        state = status.probe if which == "workpiece" else status.tool_probe if which == "tool" else None
+        if state is None:
+            return
+        refusal = None
+        if which == "workpiece" and spec.needs_probe and ctx.probe is not None and not state.in_spindle:
+            refusal = alarms.PROBE_NOT_IN_SPINDLE
+        elif state.armed is False:
+            refusal = alarms.PROBE_NOT_ARMED if which == "workpiece" else alarms.TOOL_PROBE_NOT_ARMED
+        elif state.deflected:
+            refusal = alarms.PROBE_DEFLECTED if which == "workpiece" else alarms.TOOL_PROBE_DEFLECTED
+        if refusal is not None:
+            self._env.post_alarm(refusal.number, refusal.text)
+            raise WorkflowError(409, "alarm", f"{refusal.number} {refusal.text}: {refusal.remedy}")
 
     def _run_point(self, session: MeasureSession, spec: TaskSpec, n: int, ctx: MeasuringContext,
                    count_steps: bool = True) -> dict:

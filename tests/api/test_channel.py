@@ -171,7 +171,7 @@ def test_after_the_program_jog_works_again(client, held_program):
 
 def test_a_running_jog_measurement_locks_nc_run(client):
     real_time(client)
-    ok(client.post("/api/machine/goto", json={"X": 290, "Y": 180, "Z": -100}, params={"coords": "MCS"}))
+    ok(client.post("/api/machine/goto", json={"X": 290, "Y": 180, "Z": -100}))    # tip 20 mm above the hole
     session = ok(client.post("/api/measure", json={"task": "hole.1", "params": {}}))
     out: dict = {}
     thread = threading.Thread(target=lambda: out.update(r=client.post(f"/api/measure/{session['id']}/start")),
