@@ -15,6 +15,7 @@ from . import (
     offsets,
     panel,
     parts,
+    plant,
     plc,
     probes,
     settings,
@@ -29,7 +30,8 @@ from . import (
 
 web_router = APIRouter(include_in_schema=False, dependencies=[Depends(guard)])   # app/access/deps.py
 for module in (panel, jog, offsets, tools, machine_view, settings, tilted_setup, measure, tool_probes,
-               task_screens, log, setup_support, probes, plc, signin, docs, nc, memories, task_help, parts):
+               task_screens, log, setup_support, probes, plc, signin, docs, nc, memories, task_help, parts,
+               plant):
     web_router.include_router(module.router)
 
 __all__ = ["web_router"]
