@@ -315,6 +315,17 @@ NC_INTERNAL = _define(
     65199, "NC_INTERNAL", "Internal error of the part-program interpreter", "零件程序解释器内部错误",
     "Note the block and the message, press Reset and report it.")
 
+# Product-defined: the start guard (issue 24 §1, design.md §10.1). Nothing has moved; the probe is intact.
+START_GUARD_COLLISION = _define(
+    65300, "START_GUARD_COLLISION", "Start guard: the planned path would run into material",
+    "启动保护：计划路径会撞到材料",
+    "Nothing moved. Position the probe as the measuring screen's picture shows (above the feature, "
+    "clear of it) or correct the parameters named in the message, then press NC Start again.")
+START_GUARD_LIMIT = _define(
+    65301, "START_GUARD_LIMIT", "Start guard: the planned path leaves the travel range",
+    "启动保护：计划路径超出行程范围",
+    "Nothing moved. Start the measurement farther from the axis limits, or shorten the measuring path.")
+
 # --- turning cycles: alarms of spec/turning.md §8 the catalogue lacked (seed 001 [L28123–L28133]) ---
 TOOL_ENVIRONMENT = _define(
     61405, "TOOL_ENVIRONMENT", "Tool environment in _TENV does not exist", "_TENV中刀具范围不存在",

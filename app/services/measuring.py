@@ -248,6 +248,12 @@ class MeasuringEnv:
         entry["correction"] = outcome.correction
         return outcome
 
+    def guard_off(self, task: str) -> None:
+        """``params.guard: false`` (design.md §10.1): only at the ``settings`` level, audited."""
+        check_actor(self._settings, ["settings"])
+        with self._db.unit() as unit:
+            unit.add_audit("guard", task, {"guard": True}, {"guard": False}, "measure", {"task": task})
+
     def activate(self, name: str) -> None:
         self._ms.activate(name)
 
