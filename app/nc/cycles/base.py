@@ -281,6 +281,9 @@ class Call:
         except WorkflowError as exc:
             raise self.alarm_of(exc, session) from None
         except HmiError as exc:          # access level, storage, correction out of range, ...
+            if exc.code == "guard":      # the start guard refused the path: nothing moved (issue 24 §1)
+                code = int((exc.extra.get("alarm") or {}).get("code") or 0)
+                raise CycleAlarm(alarms.by_number(code) or alarms.START_GUARD_COLLISION, exc.message) from None
             definition = alarms.NC_WRITE_PROTECTED if exc.code in ("access_level", "unauthenticated") \
                 else alarms.NC_VALUE_RANGE
             raise CycleAlarm(definition, exc.message) from None
