@@ -34,7 +34,7 @@ def rounds(n: int, busy: bool, what: str) -> list[float]:
             real_time(api, test_scenario())
             with killable_chromium(Path(tmp) / f"profile{k}") as (chromium, port), sync_playwright() as pw:
                 act = (lambda page: kill(chromium)) if what == "kill" else (lambda page: page.mouse.up())
-                at_act, at_rest, _ = hold_then(pw, port, url, api, act)
+                at_act, at_rest, _ = hold_then(pw.chromium, port, url, api, act)
             run_on.append(at_rest - at_act)
     return run_on
 

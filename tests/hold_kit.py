@@ -2,7 +2,7 @@
 
 Playwright's own browser cannot be killed from outside without losing its driver, so Chromium is
 started here as a process of its own (remote debugging on a free port) and Playwright attaches
-to it over CDP. ``hold_then`` holds the Cont jog key of axis Y on /jog until the axis has moved
+to it over CDP (``browser_type``: Playwright's chromium). ``hold_then`` holds the Cont jog key of axis Y on /jog until the axis has moved
 a little, then runs ``act(page, chromium)`` (kill the browser, or let go of the key) and reports
 the axis position at that moment and where it came to rest.
 """
@@ -71,10 +71,10 @@ def real_time(api: httpx.Client, scenario: dict) -> None:
     assert api.post("/api/sim/scenario", json={**scenario, "reset_data": True}).status_code == 200
 
 
-def hold_then(playwright, port: int, base_url: str, api: httpx.Client,
+def hold_then(browser_type, port: int, base_url: str, api: httpx.Client,
               act: Callable[[object], None]) -> tuple[float, float, float]:
     """(Y when ``act`` ran, Y at rest, seconds from ``act`` until the API reported the axis at rest)."""
-    browser = playwright.chromium.connect_over_cdp(f"http://127.0.0.1:{port}")
+    browser = browser_type.connect_over_cdp(f"http://127.0.0.1:{port}")
     page = browser.contexts[0].new_page()
     page.set_default_timeout(10_000)
     page.goto(base_url + "/jog")

@@ -10,7 +10,6 @@ from __future__ import annotations
 import pytest
 from hmi_testdata import test_scenario
 from hold_kit import JOG_FEED, busy_core, hold_then, kill, killable_chromium, real_time
-from playwright.sync_api import sync_playwright
 
 pytestmark = pytest.mark.e2e
 
@@ -19,10 +18,10 @@ HOLD_S, RENEW_S = 0.5, 0.15
 WATCHDOG_RUN_ON_MM = JOG_FEED / 60.0 * (HOLD_S - RENEW_S)
 
 
-def test_killing_chromium_while_it_holds_a_jog_key_stops_the_axis(live_server, api, tmp_path):
+def test_killing_chromium_while_it_holds_a_jog_key_stops_the_axis(browser, live_server, api, tmp_path):
     real_time(api, test_scenario())
-    with busy_core(), killable_chromium(tmp_path / "profile") as (chromium, port), sync_playwright() as pw:
-        at_kill, at_rest, _ = hold_then(pw, port, live_server, api, lambda page: kill(chromium))
+    with busy_core(), killable_chromium(tmp_path / "profile") as (chromium, port):
+        at_kill, at_rest, _ = hold_then(browser.browser_type, port, live_server, api, lambda page: kill(chromium))
     assert at_rest >= at_kill
     assert at_rest - at_kill < WATCHDOG_RUN_ON_MM, (
         f"ran on {at_rest - at_kill:.2f} mm after the browser died: stopped by the renewal deadline, "
@@ -31,8 +30,8 @@ def test_killing_chromium_while_it_holds_a_jog_key_stops_the_axis(live_server, a
     assert not state["busy"] and not state["alarms"]
 
 
-def test_letting_go_stops_the_axis_beside_a_busy_core(live_server, api, tmp_path):
+def test_letting_go_stops_the_axis_beside_a_busy_core(browser, live_server, api, tmp_path):
     real_time(api, test_scenario())
-    with busy_core(), killable_chromium(tmp_path / "profile") as (_chromium, port), sync_playwright() as pw:
-        at_release, at_rest, _ = hold_then(pw, port, live_server, api, lambda page: page.mouse.up())
+    with busy_core(), killable_chromium(tmp_path / "profile") as (_chromium, port):
+        at_release, at_rest, _ = hold_then(browser.browser_type, port, live_server, api, lambda page: page.mouse.up())
     assert 0.0 <= at_rest - at_release < WATCHDOG_RUN_ON_MM
