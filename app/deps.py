@@ -21,6 +21,7 @@ from app.services import (
     ToolProbeService,
     ToolService,
 )
+from app.services.plant import PlantService
 from app.services.plc import PlcSimulator
 from app.services.probe_test import ProbeTestService
 from app.workflow.service import WorkflowService
@@ -55,3 +56,4 @@ PlcDep = Annotated[PlcSimulator, _part("plc")]
 ProbeTestDep = Annotated[ProbeTestService, _part("probe_test")]
 ResultsDep = Annotated[ResultsService, _part("results")]
 QualityDep = Annotated[QualityService, _part("quality")]
+PlantDep = Annotated[PlantService, _part("plant")]

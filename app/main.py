@@ -49,6 +49,7 @@ from app.services import (
     ToolService,
 )
 from app.services.measuring import MeasuringEnv
+from app.services.plant import PlantService
 from app.services.plc import PlcSimulator
 from app.services.probe_test import ProbeTestService
 from app.services.scenarios import read_scenario
@@ -63,7 +64,8 @@ STATIC_DIR = ROOT / "static"
 
 def build_services(settings: Settings, scenario: Scenario | LatheScenario) -> Services:
     controller = build_machine(settings.machine, scenario)   # an unknown name fails before the db is touched
-    db = Database(settings.db_path, rotary_axes=tuple(a for a in scenario.axes if a not in "XYZ"))
+    db = Database(settings.database, rotary_axes=tuple(a for a in scenario.axes if a not in "XYZ"),
+                  machine=settings.machine_name)
     gud = SettingsService(db)
     machine = MachineService(db, controller, scenario, gud,
                              rebuild=lambda other: build_machine(settings.machine, other))   # lathe <-> mill
@@ -85,6 +87,7 @@ def build_services(settings: Settings, scenario: Scenario | LatheScenario) -> Se
     machine.add_interlock(services.workflow.interlock)
     machine.lock_source = lambda: services.nc.lock() or services.workflow.lock()
     services.plc = PlcSimulator(lambda: services.workflow)
+    services.plant = PlantService(db, machine.status)
     services.probe_test = ProbeTestService(machine)
     return services
 
@@ -112,7 +115,12 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         endpoints = _app.state.endpoints
         for endpoint in endpoints:              # OPC UA, MTConnect: a start error stops the HMI's start
             await asyncio.to_thread(endpoint.start)
+        plant = services.plant
+        if plant is not None:                   # the plant view's heartbeat (design.md §10.5)
+            await asyncio.to_thread(plant.start)
         yield
+        if plant is not None:
+            plant.stop()
         for endpoint in reversed(endpoints):    # before the services they read close
             await asyncio.to_thread(endpoint.stop)
         if services.nc is not None:             # build_services made it

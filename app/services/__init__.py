@@ -16,6 +16,7 @@ from .machine_service import MachineService
 from .memories import MemoryService
 from .nc import NcService, ProgramService
 from .offsets import OffsetService
+from .plant import PlantService
 from .plc import PlcSimulator
 from .probe_test import ProbeTestService
 from .probes import ProbeService, ToolProbeService
@@ -43,6 +44,7 @@ class Services:
     probe_test: ProbeTestService | None = None
     results: ResultsService | None = None
     quality: QualityService | None = None
+    plant: PlantService | None = None
 
 
 __all__ = ["LogService", "MachineService", "MemoryService", "NcService", "OffsetService", "ProbeService", "ProgramService", "QualityService", "ResultsService",
