@@ -1,4 +1,4 @@
-"""``python -m app [--host 127.0.0.1] [--port 8000] [--db PATH] [--scenario PATH] [--machine sim]
+"""``python -m app [--host 127.0.0.1] [--port 8000] [--db PATH|URL] [--machine-name NAME] [--scenario PATH] [--machine sim]
 [--opcua PORT [--opcua-umati]] [--mtconnect PORT]`` (design.md §4, §9.6, §9.7) serves the HMI, with
 ``--opcua`` also OPC UA, with ``--mtconnect`` an MTConnect SHDR adapter (docs/opcua.md);
 the access subcommands (design.md §9.2) work on the database:
@@ -29,7 +29,11 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(prog="python -m app", description="Measure-in-JOG HMI (the simulated machine by default)")
     parser.add_argument("--host", default=None, help="bind address (default 127.0.0.1; another needs a user)")
     parser.add_argument("--port", type=int, default=None, help="TCP port (default 8000)")
-    parser.add_argument("--db", type=Path, default=None, help="SQLite file (default data/hmi.db)")
+    parser.add_argument("--db", default=None, metavar="PATH|URL",
+                        help="SQLite file (default data/hmi.db) or a plant's PostgreSQL database, "
+                             "postgresql+psycopg://USER@HOST/DBNAME (design.md §10.5; also HMI_DB_URL)")
+    parser.add_argument("--machine-name", default=None, metavar="NAME",
+                        help="this HMI's name on a shared database (default: the host name)")
     parser.add_argument("--scenario", type=Path, default=None, help="scenario JSON (default: built-in demo)")
     parser.add_argument("--time-scale", type=float, default=None,
                         help="override the scenario's machine.time_scale (0 = no waiting)")
@@ -71,7 +75,10 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
 
 def settings_from_args(args: argparse.Namespace) -> Settings:
     """Command-line values over ``HMI_*`` environment values over the defaults."""
-    given = {"host": args.host, "port": args.port, "db_path": args.db,
+    db_url = args.db if args.db is not None and "://" in args.db else None
+    db_path = Path(args.db) if args.db is not None and db_url is None else None
+    given = {"host": args.host, "port": args.port, "db_path": db_path, "db_url": db_url,
+             "machine_name": getattr(args, "machine_name", None),
              "scenario_path": args.scenario, "time_scale": args.time_scale, "machine": args.machine,
              "trusted_hosts": getattr(args, "trusted_host", None), "opcua_port": getattr(args, "opcua", None),
              "opcua_umati": getattr(args, "opcua_umati", None), "mtconnect_port": getattr(args, "mtconnect", None)}
@@ -95,7 +102,7 @@ def run_access_command(args: argparse.Namespace, settings: Settings) -> int:
     from app.access.service import AccessError, AccessService
     from db import Actor, Database, acting_as
 
-    with Database(settings.db_path) as db, acting_as(Actor("cli", 0)):
+    with Database(settings.database, machine=settings.machine_name) as db, acting_as(Actor("cli", 0)):
         access = AccessService(db, settings.session_hours)
         try:
             if args.command == "user":
@@ -143,12 +150,12 @@ def refuse_open_trainer(settings: Settings) -> str | None:
 
     if is_loopback_host(settings.host):
         return None
-    with Database(settings.db_path) as db, db.unit(readonly=True) as unit:
+    with Database(settings.database, machine=settings.machine_name) as db, db.unit(readonly=True) as unit:
         if unit.users_exist():
             return None
     return (f"--host {settings.host} would serve the network, but no user is configured: without users the "
             "HMI is the stand-alone trainer (every function allowed) and serves only this computer. "
-            f"Create a user first: python -m app --db {settings.db_path} user add NAME --level 1")
+            f"Create a user first: python -m app --db {settings.database} user add NAME --level 1")
 
 
 def endpoint_problem(settings: Settings) -> str | None:

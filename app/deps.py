@@ -14,13 +14,16 @@ from app.services import (
     OffsetService,
     ProbeService,
     ProgramService,
+    QualityService,
     ResultsService,
     Services,
     SettingsService,
     ToolProbeService,
     ToolService,
 )
+from app.services.plant import PlantService
 from app.services.plc import PlcSimulator
+from app.services.probe_test import ProbeTestService
 from app.workflow.service import WorkflowService
 
 
@@ -50,4 +53,7 @@ WorkflowDep = Annotated[WorkflowService, _part("workflow")]
 NcDep = Annotated[NcService, _part("nc")]
 ProgramsDep = Annotated[ProgramService, _part("programs")]
 PlcDep = Annotated[PlcSimulator, _part("plc")]
+ProbeTestDep = Annotated[ProbeTestService, _part("probe_test")]
 ResultsDep = Annotated[ResultsService, _part("results")]
+QualityDep = Annotated[QualityService, _part("quality")]
+PlantDep = Annotated[PlantService, _part("plant")]

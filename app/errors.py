@@ -149,6 +149,12 @@ def install_handlers(app: FastAPI) -> None:
         log.error("storage unavailable: %s", exc)
         return error_response(503, "storage_unavailable", f"Nothing was stored: {exc}")
 
+    @app.exception_handler(OverflowError)
+    async def _overflow(_: Request, exc: OverflowError):
+        # the safety net of app.checks: a number too large for a float that a check missed
+        log.warning("unchecked number overflow: %s", exc)
+        return error_response(422, "validation", "a number is too large")
+
     @app.exception_handler(ValueError)
     async def _value_error(_: Request, exc: ValueError):
         # A ValueError escaping a service is bad input the service did not name (e.g. numpy/engine).

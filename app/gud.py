@@ -34,7 +34,9 @@ def _level(function: str) -> Any:  # what pydantic's Field returns: the default,
 
 
 class GudSettings(BaseModel):
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, validate_assignment=True)
+    # strict (issue 25): a JSON true is no feed of 1 mm/min, the text "12" no number; the settings
+    # screen turns its typed text into numbers first (app.web.settings.parse_form)
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, validate_assignment=True, strict=True)
 
     # --- general (_JM_I, _JM_B, _CBIT) -------------------------------------------------------
     plane: Literal["G17", "G18", "G19"] = _f("G17", "_JM_I[3]", "Working plane for measuring", GENERAL)
@@ -47,9 +49,14 @@ class GudSettings(BaseModel):
     override_mismatch: Literal["warn", "refuse"] = _f(
         "warn", "-", "Feed override differs from calibration", GENERAL)
     inch_display: bool = _f(False, "E_MESS_IS_METRIC", "Display in inch (storage stays mm)", GENERAL)  # = units
-    pretravel_frame: Literal["probe", "machine"] = _f(
-        "probe", "-", "Probe pre-travel turns with the spindle (probe) or stays with the machine axes",
-        GENERAL)
+    calibration_invalid: Literal["warn", "refuse"] = _f(
+        "warn", "-", "Measuring with an uncalibrated or invalid probe calibration", GENERAL)
+    calibration_max_age_h: float = _f(0.0, "-", "Probe calibration valid for (0 = no limit)", GENERAL, "h",
+                                      ge=0, le=100_000)
+    repeatability_limit: float = _f(0.002, "-", "Probe repeatability limit (2σ)", GENERAL, "mm", gt=0, le=1)
+    pretravel_frame: Literal["auto", "probe", "machine"] = _f(
+        "auto", "-", "Probe pre-travel turns with the spindle (probe) or stays with the machine axes "
+        "(auto = the ring calibration decides)", GENERAL)
 
     # --- workpiece measuring -------------------------------------------------------------------
     attempts: Literal[1, 5] = _f(1, "_JM_B[1]", "Measuring attempts", WORKPIECE)
@@ -142,6 +149,14 @@ class GudSettings(BaseModel):
         if isinstance(data, dict) and "units" in data:
             data = {**data, "inch_display": data["units"] == "inch"}
         return data
+
+    @field_validator("*", mode="before")
+    @classmethod
+    def _no_bool_for_numbers(cls, value, info):
+        """``true`` is no 1 (a strict Literal[1, 5] still takes it, since True == 1)."""
+        if isinstance(value, bool) and cls.model_fields[info.field_name].annotation is not bool:
+            raise ValueError("must be a number, not true/false")
+        return value
 
     @field_validator("measuring_wo")
     @classmethod

@@ -41,6 +41,7 @@ from app.services import (
     OffsetService,
     ProbeService,
     ProgramService,
+    QualityService,
     ResultsService,
     Services,
     SettingsService,
@@ -48,7 +49,9 @@ from app.services import (
     ToolService,
 )
 from app.services.measuring import MeasuringEnv
+from app.services.plant import PlantService
 from app.services.plc import PlcSimulator
+from app.services.probe_test import ProbeTestService
 from app.services.scenarios import read_scenario
 from app.web import web_router
 from app.web.language import LanguageMiddleware
@@ -61,7 +64,8 @@ STATIC_DIR = ROOT / "static"
 
 def build_services(settings: Settings, scenario: Scenario | LatheScenario) -> Services:
     controller = build_machine(settings.machine, scenario)   # an unknown name fails before the db is touched
-    db = Database(settings.db_path, rotary_axes=tuple(a for a in scenario.axes if a not in "XYZ"))
+    db = Database(settings.database, rotary_axes=tuple(a for a in scenario.axes if a not in "XYZ"),
+                  machine=settings.machine_name)
     gud = SettingsService(db)
     machine = MachineService(db, controller, scenario, gud,
                              rebuild=lambda other: build_machine(settings.machine, other))   # lathe <-> mill
@@ -73,12 +77,18 @@ def build_services(settings: Settings, scenario: Scenario | LatheScenario) -> Se
     services.memories = MemoryService(db)
     env = MeasuringEnv(db, machine, gud)
     services.results = env.results = ResultsService(db, gud, getattr(settings, "machine_name", None))
+    services.quality = QualityService(db, services.results)
     services.workflow = WorkflowService(env)
     services.nc = NcService(db, machine, env, gud)
     services.programs = ProgramService(db, services.nc)
     machine.mode_source = lambda: services.nc.mode
     machine.on_discard(services.workflow.discard_points)
+    machine.on_reset(services.workflow.abort, services.workflow.wait_idle)   # one Reset (issue 24 §3)
+    machine.add_interlock(services.workflow.interlock)
+    machine.lock_source = lambda: services.nc.lock() or services.workflow.lock()
     services.plc = PlcSimulator(lambda: services.workflow)
+    services.plant = PlantService(db, machine.status)
+    services.probe_test = ProbeTestService(machine)
     return services
 
 
@@ -105,7 +115,12 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         endpoints = _app.state.endpoints
         for endpoint in endpoints:              # OPC UA, MTConnect: a start error stops the HMI's start
             await asyncio.to_thread(endpoint.start)
+        plant = services.plant
+        if plant is not None:                   # the plant view's heartbeat (design.md §10.5)
+            await asyncio.to_thread(plant.start)
         yield
+        if plant is not None:
+            plant.stop()
         for endpoint in reversed(endpoints):    # before the services they read close
             await asyncio.to_thread(endpoint.stop)
         if services.nc is not None:             # build_services made it

@@ -6,7 +6,6 @@ Validation models shared by the services (API/screen writes) and the measuring w
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from typing import Literal
 
@@ -21,6 +20,8 @@ from pydantic import (
     field_validator,
 )
 
+from app import checks
+from app.errors import InvalidInput
 from engine.lobing import lobing_map_from_json
 from engine.types import TRIGGER_KEYS
 
@@ -35,9 +36,10 @@ def frame_out_of_range(frame: Mapping) -> tuple[str, str] | None:
     for part in ("trans", "fine", "rot"):
         for axis, value in (frame.get(part) or {}).items():
             field = f"{part}.{axis}"
-            number = float(value)
-            if not math.isfinite(number):
-                return field, f"{field}: must be a finite number"
+            try:
+                number = checks.number(value, field)
+            except InvalidInput as exc:
+                return field, exc.message
             if part == "rot" and not abs(number) < 360.0:
                 return field, f"{field}: rotation must lie in (-360, 360) degrees"
             if abs(number) > MAX_TRANSLATION:
@@ -88,6 +90,11 @@ class ProbeData(BaseModel):
     # the direction-dependent trigger map of a ring calibration with more than 4 directions
     # (engine.lobing.LobingMap.values_json, design.md §9.8); None: the 4 trigger values only
     lobing: dict | None = None
+    # what the ring calibration measured (issue [probe-health] item 5): the ball diameter from the
+    # chord sagittas (None: the chords could not tell, the nominal was used) and whether the
+    # pre-travel turns with the spindle ("probe") or stays with the machine axes ("machine")
+    measured_ball_diameter: StrictFloat | None = Field(None, gt=0, le=100)
+    pretravel_frame: Literal["probe", "machine"] | None = None
 
     # A probe's own physics bounds its data (measuring-math §5.1, measuring-math §5.2): the ball centre switches
     # within one ball diameter of the surface, the stylus is off the spindle axis by at most

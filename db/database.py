@@ -1,24 +1,29 @@
-"""SQLite engine set-up (WAL, foreign keys), migrations at start-up, default data, units of work."""
+"""Engine set-up (SQLite file with WAL and foreign keys, or PostgreSQL through psycopg 3), migrations
+at start-up, default data, units of work (design.md §10.5)."""
 
 from __future__ import annotations
 
 import functools
+import re
+import socket
 import sqlite3
 import threading
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
 from alembic import command
 from alembic.config import Config
 from alembic.runtime.migration import MigrationContext
 from alembic.script import ScriptDirectory
-from sqlalchemy import Connection, Engine, create_engine, event
+from sqlalchemy import URL, Connection, Engine, create_engine, event, make_url, select, update
 from sqlalchemy.exc import DBAPIError, OperationalError
 from sqlalchemy.orm import Session
 from sqlalchemy.pool import ConnectionPoolEntry
 
-from db.repository import Unit, offset_layout, seed_defaults
+from db.models import Machine
+from db.repository import Unit, offset_layout, seed_defaults, utc_now
 
 MIGRATIONS_DIR = Path(__file__).resolve().parent / "migrations"
 
@@ -27,13 +32,45 @@ class StorageUnavailable(Exception):
     """The database cannot be opened or written (disk full, read-only file, gone): nothing of the
     transaction was stored. ``str()`` names the file and the cause."""
 BUSY_TIMEOUT_MS = 10_000
+MACHINE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,63}")
+# pg_advisory_xact_lock key of migrating and seeding: HMIs starting together take turns
+MIGRATION_LOCK = 0x484D4931
 
 
-def alembic_config(connection: Connection | None = None) -> Config:
-    """Alembic configuration built in code, valid from any cwd and from an installed package."""
+def default_machine_name() -> str:
+    """The host name (its first label), the machine name when none is given."""
+    name = socket.gethostname().split(".")[0] or "hmi"
+    return name if MACHINE_NAME.fullmatch(name) else "hmi"
+
+
+def check_machine_name(name: str) -> str:
+    if not isinstance(name, str) or not MACHINE_NAME.fullmatch(name):
+        raise ValueError(f"machine name must be 1-64 letters, digits, '.', '_' or '-' (starting with a "
+                         f"letter or digit), got {name!r}")
+    return name
+
+
+def database_url(target: str | Path) -> URL:
+    """``--db`` as a SQLAlchemy URL: a ``postgresql://`` (driver psycopg 3) or ``sqlite://`` URL
+    as given, anything else a SQLite file path."""
+    text = str(target)
+    if "://" not in text:
+        return URL.create("sqlite", database=text)
+    url = make_url(text)
+    if url.get_backend_name() == "postgresql":
+        return url.set(drivername="postgresql+psycopg")
+    if url.get_backend_name() != "sqlite":
+        raise ValueError(f"the database must be a SQLite file or a postgresql:// URL, got {url.get_backend_name()}://")
+    return url
+
+
+def alembic_config(connection: Connection | None = None, machine: str | None = None) -> Config:
+    """Alembic configuration built in code, valid from any cwd and from an installed package.
+    ``machine``: the name that rows stored before plant mode (0008) are given."""
     config = Config()
     config.set_main_option("script_location", str(MIGRATIONS_DIR))
     config.attributes["connection"] = connection
+    config.attributes["machine"] = machine or default_machine_name()
     return config
 
 
@@ -43,18 +80,21 @@ def head_revision() -> str | None:
     return ScriptDirectory.from_config(alembic_config()).get_current_head()
 
 
-def upgrade_to_head(connection: Connection) -> None:
+def upgrade_to_head(connection: Connection, machine: str | None = None) -> None:
     """``alembic upgrade head`` on an open connection; skipped cheaply when already current."""
     if MigrationContext.configure(connection).get_current_revision() != head_revision():
-        command.upgrade(alembic_config(connection), "head")
+        command.upgrade(alembic_config(connection, machine), "head")
 
 
 class Database:
-    """One SQLite file: opens, migrates and seeds it; hands out units of work.
+    """One database: a SQLite file or a PostgreSQL database shared by the HMIs of a plant. Opens,
+    migrates and seeds it; hands out units of work on the rows of one machine (``machine``).
 
-    Every unit is one transaction. Writing units take SQLite's write lock at BEGIN (``BEGIN
-    IMMEDIATE``), so read-modify-write sequences of two processes cannot interleave; read-only
-    units (``unit(readonly=True)``) start deferred and never block a writer in WAL mode.
+    Every unit is one transaction. A writing unit first raises its machine's write count
+    (``machines.writes``): on PostgreSQL that row lock makes the writers of one machine take turns
+    across processes until the commit; on SQLite the file's write lock, taken at BEGIN (``BEGIN
+    IMMEDIATE``), does. So read-modify-write sequences of two processes cannot interleave.
+    Read-only units (``unit(readonly=True)``) never block a writer.
     """
 
     def __init__(
@@ -63,26 +103,45 @@ class Database:
         extra_settable: int = 4,
         basic_frames: int = 2,
         rotary_axes: Sequence[str] = (),
+        machine: str | None = None,
     ):
-        self.path = Path(path)
+        self.url = database_url(path)
+        self.is_sqlite = self.url.get_backend_name() == "sqlite"
+        self.path: Path | None = Path(self.url.database or "") if self.is_sqlite else None
+        self.where = str(self.path) if self.is_sqlite else self.url.render_as_string(hide_password=True)
+        self.machine = check_machine_name(default_machine_name() if machine is None else machine)
         self._layout = offset_layout(extra_settable, basic_frames)
-        self._generation = 0                   # committed write units so far (see ``generation``)
         self._write_turn = threading.RLock()   # held by this process's writing unit
         self._rotary_axes = tuple(rotary_axes)
-        # check_same_thread off: the pool hands connections to FastAPI's worker threads.
-        self._engine = create_engine(f"sqlite:///{self.path}", connect_args={"check_same_thread": False})
-        event.listen(self._engine, "connect", _configure_sqlite_connection)
-        event.listen(self._engine, "begin", _begin_transaction)
-        self._write_engine = self._engine.execution_options(sqlite_begin="BEGIN IMMEDIATE")
+        if self.is_sqlite:
+            # check_same_thread off: the pool hands connections to FastAPI's worker threads.
+            self._engine = create_engine(self.url, connect_args={"check_same_thread": False})
+            event.listen(self._engine, "connect", _configure_sqlite_connection)
+            event.listen(self._engine, "begin", _begin_transaction)
+            self._write_engine: Engine = self._engine.execution_options(sqlite_begin="BEGIN IMMEDIATE")
+        else:
+            # a writer waits at most as long as on SQLite for another machine's turn to end
+            self._engine = create_engine(self.url, pool_pre_ping=True, connect_args={
+                "options": f"-c lock_timeout={BUSY_TIMEOUT_MS} -c timezone=UTC", "connect_timeout": 10})
+            self._write_engine = self._engine
         try:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
+            if self.path is not None:
+                self.path.parent.mkdir(parents=True, exist_ok=True)
             with self._write_engine.begin() as connection:
-                upgrade_to_head(connection)
+                self._migration_turn(connection)
+                upgrade_to_head(connection, self.machine)
             with Session(self._write_engine) as session, session.begin():
-                seed_defaults(session, self._layout, self._rotary_axes)
+                self._migration_turn(session.connection())
+                seed_defaults(session, self._layout, self._rotary_axes, self.machine)
         except (OSError, DBAPIError) as exc:
             self._engine.dispose()
-            raise StorageUnavailable(f"cannot open the database {self.path}: {_cause(exc)}") from exc
+            raise StorageUnavailable(f"cannot open the database {self.where}: {_cause(exc)}") from exc
+
+    def _migration_turn(self, connection: Connection) -> None:
+        """PostgreSQL: HMIs starting at once migrate and seed one after the other (SQLite: BEGIN
+        IMMEDIATE already did)."""
+        if not self.is_sqlite:
+            connection.exec_driver_sql(f"SELECT pg_advisory_xact_lock({MIGRATION_LOCK})")
 
     @contextmanager
     def unit(self, readonly: bool = False) -> Iterator[Unit]:
@@ -90,37 +149,51 @@ class Database:
         if readonly:
             with Session(self._engine) as session:  # closing rolls back
                 event.listen(session, "before_flush", _refuse_write)
-                unit = Unit(session, self._layout)
+                unit = Unit(session, self._layout, self.machine)
                 try:
                     yield unit
                 finally:
                     unit.detach()
             return
-        # This process's writers take turns from BEGIN until the count is raised after the
-        # commit: a writer never sees a committed change not yet counted, and a reader that
-        # read the count before a commit sees it raised afterwards (see ``generation``).
+        # This process's writers take turns (one connection, not a queue at the database); the
+        # write count rises in the unit's own transaction, so it is raised exactly when the unit's
+        # changes become visible, to every process (see ``generation``).
         if not self._write_turn.acquire(timeout=BUSY_TIMEOUT_MS / 1000):
-            raise StorageUnavailable(f"the database {self.path} cannot be written: another write "
+            raise StorageUnavailable(f"the database {self.where} cannot be written: another write "
                                      f"did not end within {BUSY_TIMEOUT_MS // 1000} s")
         try:
             with Session(self._write_engine, expire_on_commit=False) as session, session.begin():
-                unit = Unit(session, self._layout)
+                session.execute(update(Machine).where(Machine.name == self.machine)
+                                .values(writes=Machine.writes + 1, last_seen=utc_now()))
+                unit = Unit(session, self._layout, self.machine)
                 try:
                     yield unit
                 finally:
                     unit.detach()
-            self._generation += 1
-        except OperationalError as exc:      # disk full, read-only file, I/O error: rolled back
-            raise StorageUnavailable(f"the database {self.path} cannot be written: {_cause(exc)}") from exc
+        except OperationalError as exc:      # disk full, read-only file, I/O error, lock timeout: rolled back
+            raise StorageUnavailable(f"the database {self.where} cannot be written: {_cause(exc)}") from exc
         finally:
             self._write_turn.release()
 
     @property
     def generation(self) -> int:
-        """Counts this process's committed writes, raised after each commit: what a reader reads
-        after reading the count is still the stored value while the count stays the same (this
-        process is the database's only writer), so it may be cached under the count read."""
-        return self._generation
+        """This machine's committed write units, of every process on the database (read from it):
+        raised in the same transaction as the unit's changes, so what a reader reads after reading
+        the count is still the stored value while the count stays the same and may be cached
+        under the count read."""
+        with self._engine.connect() as connection:
+            count = connection.scalar(select(Machine.writes).where(Machine.name == self.machine))
+        return int(count or 0)
+
+    def report_status(self, status: dict[str, Any]) -> None:
+        """This HMI is alive, with ``status`` (alarms, mode, ...) for the plant view: its machines
+        row only, outside the write count (no cache need read again for it)."""
+        try:
+            with self._write_engine.begin() as connection:
+                connection.execute(update(Machine).where(Machine.name == self.machine)
+                                   .values(last_seen=utc_now(), status=status))
+        except OperationalError as exc:
+            raise StorageUnavailable(f"the database {self.where} cannot be written: {_cause(exc)}") from exc
 
     def offset_names(self) -> list[str]:
         """The configured frames in chain order (fixed when the database is opened)."""

@@ -9,6 +9,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from sqlalchemy import JSON, CheckConstraint, Float, ForeignKey, Index, Integer, String, UniqueConstraint
+from sqlalchemy.dialects.postgresql import JSONB
 from sqlalchemy.orm import DeclarativeBase, Mapped, declared_attr, mapped_column
 
 GEOMETRY_AXES = ("X", "Y", "Z")
@@ -19,8 +20,20 @@ AXES = GEOMETRY_AXES + ROTARY_AXES
 FRAME_KINDS = ("setframe", "chbasic", "settable")
 MAX_PROBE_NUMBER = 99            # probe and tool-probe records 1..99
 
-# JSON that stores Python None as SQL NULL (nullable document columns).
-NullableJSON = JSON(none_as_null=True)
+# JSON documents: JSONB on PostgreSQL (design.md §10.5); NullableJSON stores Python None as SQL NULL.
+Document = JSON().with_variant(JSONB(), "postgresql")
+NullableJSON = JSON(none_as_null=True).with_variant(JSONB(none_as_null=True), "postgresql")
+MACHINE_NAME_LENGTH = 64
+
+
+def machine_key() -> Mapped[str]:
+    """The machine (HMI) a row belongs to, part of the key (design.md §10.5)."""
+    return mapped_column(String(MACHINE_NAME_LENGTH), primary_key=True, sort_order=-1)
+
+
+def machine_column() -> Mapped[str]:
+    """The machine (HMI) that wrote a row; '' only for a row of no machine (never written so)."""
+    return mapped_column(String(MACHINE_NAME_LENGTH), server_default="", sort_order=-1)
 
 
 class Base(DeclarativeBase):
@@ -32,7 +45,7 @@ class FrameAxis(Base):
 
     __tablename__ = "frames"
     __table_args__ = (
-        UniqueConstraint("channel", "name", "axis", name="uq_frames_channel_name_axis"),
+        UniqueConstraint("machine", "channel", "name", "axis", name="uq_frames_machine_channel_name_axis"),
         CheckConstraint(f"kind IN {FRAME_KINDS}", name="ck_frames_kind"),
         CheckConstraint(f"axis IN {AXES}", name="ck_frames_axis"),
         CheckConstraint(f"rot IS NULL OR axis IN {GEOMETRY_AXES}", name="ck_frames_rot_geometry_only"),
@@ -40,6 +53,7 @@ class FrameAxis(Base):
     )
 
     id: Mapped[int] = mapped_column(primary_key=True)
+    machine: Mapped[str] = machine_column()
     channel: Mapped[int] = mapped_column(Integer, default=1)
     name: Mapped[str] = mapped_column(String(16))            # API name: G54, BASIC_REF, BASIC_0 ...
     kind: Mapped[str] = mapped_column(String(16))
@@ -66,9 +80,11 @@ class OffsetAudit(Base):
 
     __tablename__ = "offset_audit"
     __table_args__ = (Index("ix_offset_audit_offset_id", "offset", "id"),
-                      Index("ix_offset_audit_kind_id", "kind", "id"))
+                      Index("ix_offset_audit_kind_id", "kind", "id"),
+                      Index("ix_offset_audit_machine_id", "machine", "id"))
 
     id: Mapped[int] = mapped_column(primary_key=True)
+    machine: Mapped[str] = machine_column()
     time: Mapped[str] = mapped_column(String(40))            # UTC ISO 8601
     offset: Mapped[str] = mapped_column(String(16))          # the item: G54, EV10, T9, WP1, settings ...
     before: Mapped[Any] = mapped_column(NullableJSON, nullable=True)   # None: the item did not exist
@@ -114,6 +130,7 @@ class AuthSession(Base):
     __tablename__ = "auth_sessions"
 
     id: Mapped[str] = mapped_column(String(64), primary_key=True)
+    machine: Mapped[str] = machine_column()                  # the HMI signed in at
     user_id: Mapped[int | None] = mapped_column(ForeignKey("users.id", ondelete="CASCADE"))
     created: Mapped[str] = mapped_column(String(40))
     expires: Mapped[str] = mapped_column(String(40))
@@ -125,6 +142,7 @@ class Tool(Base):
     __tablename__ = "tools"
     __table_args__ = (CheckConstraint("t > 0", name="ck_tools_t_positive"),)
 
+    machine: Mapped[str] = machine_key()
     t: Mapped[int] = mapped_column(Integer, primary_key=True, autoincrement=False)
     name: Mapped[str | None] = mapped_column(String(64))
     type: Mapped[int] = mapped_column(Integer, default=120)
@@ -139,9 +157,10 @@ class Tool(Base):
 class _ProbeRecord:
     """Columns of a numbered probe record: a JSON document (schema owned by the app) + its number."""
 
+    machine: Mapped[str] = machine_key()
     number: Mapped[int] = mapped_column(Integer, primary_key=True, autoincrement=False)
     calibrated_at: Mapped[str | None] = mapped_column(String(40))
-    data: Mapped[dict[str, Any]] = mapped_column(JSON)
+    data: Mapped[dict[str, Any]] = mapped_column(Document)
     if TYPE_CHECKING:
         __tablename__: str              # set by each mapped subclass
 
@@ -164,8 +183,9 @@ class ToolProbe(_ProbeRecord, Base):
 
 
 class _KeyValue:
+    machine: Mapped[str] = machine_key()
     key: Mapped[str] = mapped_column(String(64), primary_key=True)
-    value: Mapped[Any] = mapped_column(JSON, nullable=True)
+    value: Mapped[Any] = mapped_column(Document, nullable=True)
 
 
 class Setting(_KeyValue, Base):
@@ -189,6 +209,7 @@ class MemoryValue(Base):
         CheckConstraint("number >= 1", name="ck_memory_values_number"),
     )
 
+    machine: Mapped[str] = machine_key()
     kind: Mapped[str] = mapped_column(String(2), primary_key=True)
     number: Mapped[int] = mapped_column(Integer, primary_key=True)     # memory number n = index + 1
     value: Mapped[float] = mapped_column(Float)
@@ -198,9 +219,11 @@ class MeasurementLog(Base):
     """One measurement: task, params, raw touches, stored points, result and correction."""
 
     __tablename__ = "measurement_log"
-    __table_args__ = (Index("ix_measurement_log_task", "task"),)
+    __table_args__ = (Index("ix_measurement_log_task", "task"),
+                      Index("ix_measurement_log_machine_id", "machine", "id"))
 
     id: Mapped[int] = mapped_column(primary_key=True)
+    machine: Mapped[str] = machine_column()
     time: Mapped[str] = mapped_column(String(40))            # UTC ISO 8601
     task: Mapped[str] = mapped_column(String(32))
     target: Mapped[str | None] = mapped_column(String(16))
@@ -223,6 +246,7 @@ class Program(Base):
 
     __tablename__ = "programs"
 
+    machine: Mapped[str] = machine_key()
     name: Mapped[str] = mapped_column(String(32), primary_key=True)
     text: Mapped[str] = mapped_column(String)
     created_at: Mapped[str] = mapped_column(String(40))      # UTC ISO 8601
@@ -233,9 +257,11 @@ class Part(Base):
     """One measured part of a job (design.md §10.3): part number, order, serial, who, which program."""
 
     __tablename__ = "parts"
-    __table_args__ = (Index("ix_parts_part_number_id", "part_number", "id"),)
+    __table_args__ = (Index("ix_parts_part_number_id", "part_number", "id"),
+                      Index("ix_parts_machine_id", "machine", "id"))
 
     id: Mapped[int] = mapped_column(primary_key=True)
+    machine: Mapped[str] = machine_column()
     part_number: Mapped[str] = mapped_column(String(64))
     order: Mapped[str | None] = mapped_column(String(64))
     serial: Mapped[str | None] = mapped_column(String(64))
@@ -266,3 +292,16 @@ class Characteristic(Base):
     verdict: Mapped[str] = mapped_column(String(16))
     unit: Mapped[str] = mapped_column(String(8), default="mm")
     compensation: Mapped[float | None] = mapped_column(Float)         # the tool offset written after it, if any
+
+
+class Machine(Base):
+    """An HMI on the database (design.md §10.5): its name, when it was first and last seen, and its
+    write count (``Database.generation``: raised by every writing unit, in its transaction)."""
+
+    __tablename__ = "machines"
+
+    name: Mapped[str] = mapped_column(String(MACHINE_NAME_LENGTH), primary_key=True)
+    registered: Mapped[str] = mapped_column(String(40))                # UTC ISO 8601
+    last_seen: Mapped[str] = mapped_column(String(40))
+    writes: Mapped[int] = mapped_column(Integer, default=0)
+    status: Mapped[Any] = mapped_column(NullableJSON, nullable=True)   # what the HMI last reported

@@ -31,6 +31,7 @@ def _characteristic_dict(row: Characteristic) -> dict[str, Any]:
 
 class PartsUnit:
     _session: Session
+    machine: str                    # parts are the machine's; a characteristic is its part's
 
     def add_part(self, data: dict[str, Any]) -> dict[str, Any]:
         unknown = set(data) - set(PART_FIELDS)
@@ -38,19 +39,19 @@ class PartsUnit:
             raise ValueError(f"unknown part keys {sorted(unknown)}")
         if not isinstance(data.get("part_number"), str) or not data["part_number"]:
             raise ValueError("a part needs a part number")
-        row = Part(started=_now(), **{key: data.get(key) for key in PART_FIELDS})
+        row = Part(machine=self.machine, started=_now(), **{key: data.get(key) for key in PART_FIELDS})
         self._session.add(row)
         self._session.flush()
         return _part_dict(row)
 
     def get_part(self, part_id: int) -> dict[str, Any] | None:
         row = self._session.get(Part, part_id)
-        if row is None:
+        if row is None or row.machine != self.machine:
             return None
         return {**_part_dict(row), "characteristics": self.part_characteristics([part_id])[part_id]}
 
     def count_parts(self, part_number: str | None = None) -> int:
-        query = select(func.count(Part.id))
+        query = select(func.count(Part.id)).where(Part.machine == self.machine)
         if part_number is not None:
             query = query.where(Part.part_number == part_number)
         return int(self._session.scalar(query) or 0)
@@ -58,7 +59,7 @@ class PartsUnit:
     def list_parts(self, part_number: str | None = None, limit: int = 100, offset: int = 0,
                    oldest_first: bool = False) -> list[dict[str, Any]]:
         """Parts with their characteristics, newest first (``oldest_first``: in measuring order)."""
-        query = select(Part)
+        query = select(Part).where(Part.machine == self.machine)
         if part_number is not None:
             query = query.where(Part.part_number == part_number)
         query = query.order_by(Part.id.asc() if oldest_first else Part.id.desc()).offset(offset).limit(limit)
@@ -97,7 +98,8 @@ class PartsUnit:
         """Every characteristic of the parts of ``part_number`` (of one name if given), in measuring
         order, each with its part's fields (``part``)."""
         query = (select(Characteristic, Part).join(Part, Characteristic.part_id == Part.id)
-                 .where(Part.part_number == part_number).order_by(Characteristic.id))
+                 .where(Part.machine == self.machine, Part.part_number == part_number)
+                 .order_by(Characteristic.id))
         if name is not None:
             query = query.where(Characteristic.name == name)
         return [{**_characteristic_dict(c), "part": _part_dict(p)} for c, p in self._session.execute(query)]

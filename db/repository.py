@@ -27,6 +27,7 @@ from db.models import (
     ApiToken,
     AuthSession,
     FrameAxis,
+    Machine,
     MachineState,
     MeasurementLog,
     MemoryValue,
@@ -39,6 +40,7 @@ from db.models import (
     User,
 )
 from db.parts import PartsUnit
+from db.plant import PlantUnit
 
 CHANNEL = 1
 DEFAULT_PROBE_RECORDS = 3        # _CVAL[0], _CVAL[1]: 3 records each by default
@@ -113,30 +115,39 @@ def identity_frame(rotary_axes: Iterable[str] = ()) -> dict[str, Any]:
     }
 
 
-def seed_defaults(session: Session, layout: Iterable[OffsetSlot], rotary_axes: Iterable[str]) -> None:
-    """Adds what is missing (identity frames, empty probe records); never changes stored data."""
+def seed_defaults(session: Session, layout: Iterable[OffsetSlot], rotary_axes: Iterable[str], machine: str) -> None:
+    """Adds what is missing of ``machine`` (its row in machines, identity frames, empty probe
+    records); never changes stored data."""
     rotary_axes = tuple(rotary_axes)
     unknown = set(rotary_axes) - set(ROTARY_AXES)
     if unknown:
         raise ValueError(f"unknown rotary axes {sorted(unknown)}")
-    present = set(session.execute(select(FrameAxis.name, FrameAxis.axis).where(FrameAxis.channel == CHANNEL)))
+    now = utc_now()
+    known = session.get(Machine, machine)
+    if known is None:
+        session.add(Machine(name=machine, registered=now, last_seen=now, writes=0))
+    else:
+        known.last_seen = now
+    present = set(session.execute(select(FrameAxis.name, FrameAxis.axis)
+                                  .where(FrameAxis.machine == machine, FrameAxis.channel == CHANNEL)))
     for slot in layout:
         for axis in (*GEOMETRY_AXES, *rotary_axes):
             if (slot.name, axis) not in present:
-                session.add(_new_frame_axis(slot, axis))
+                session.add(_new_frame_axis(slot, axis, machine))
     for model in (Probe, ToolProbe):
-        numbers = set(session.scalars(select(model.number)))
+        numbers = set(session.scalars(select(model.number).where(model.machine == machine)))
         for number in range(1, DEFAULT_PROBE_RECORDS + 1):
             if number not in numbers:
-                session.add(model(number=number, calibrated_at=None, data={"number": number}))
+                session.add(model(machine=machine, number=number, calibrated_at=None, data={"number": number}))
 
 
-class Unit(PartsUnit):
+class Unit(PartsUnit, PlantUnit):
     """Repository methods of one transaction; all take and return plain JSON-ready values."""
 
-    def __init__(self, session: Session, layout: tuple[OffsetSlot, ...]):
+    def __init__(self, session: Session, layout: tuple[OffsetSlot, ...], machine: str):
         self._session: Session = session
         self._slots = {slot.name: slot for slot in layout}
+        self.machine = machine              # every machine-owned row read or written is this machine's
 
     def detach(self) -> None:
         """Called when the transaction ends: later use fails loudly instead of writing nowhere."""
@@ -155,7 +166,8 @@ class Unit(PartsUnit):
         # columns, not ORM objects: every measurement reads all frames (several times)
         rows = self._session.execute(
             select(FrameAxis.name, FrameAxis.axis, FrameAxis.coarse, FrameAxis.fine, FrameAxis.rot)
-            .where(FrameAxis.channel == CHANNEL, FrameAxis.name.in_(self._slots))
+            .where(FrameAxis.machine == self.machine, FrameAxis.channel == CHANNEL,
+                   FrameAxis.name.in_(self._slots))
         )
         by_name: dict[str, list[Row[str, str, float, float, float | None]]] = {name: [] for name in self._slots}
         for row in rows:
@@ -184,7 +196,7 @@ class Unit(PartsUnit):
                 continue
             row = rows.get(axis)
             if row is None:
-                row = rows[axis] = _new_frame_axis(slot, axis)
+                row = rows[axis] = _new_frame_axis(slot, axis, self.machine)
                 self._session.add(row)
             row.coarse, row.fine, row.rot = values.get(axis, (0.0, 0.0, 0.0 if axis in GEOMETRY_AXES else None))
         after = _frame_from_rows(rows.values())
@@ -197,7 +209,7 @@ class Unit(PartsUnit):
                   detail: dict[str, Any] | None = None) -> int:
         """One audit row naming the acting identity (``current_actor()``, else "system")."""
         actor = current_actor() or SYSTEM
-        row = OffsetAudit(time=_utc_now(), kind=kind, offset=str(name), before=_json_ready(before, "before"),
+        row = OffsetAudit(machine=self.machine, time=_utc_now(), kind=kind, offset=str(name), before=_json_ready(before, "before"),
                           after=_json_ready(after, "after"), source=str(source),
                           detail=_json_ready(detail, "detail"), who=actor.who[:80], who_level=actor.level)
         self._session.add(row)
@@ -207,7 +219,8 @@ class Unit(PartsUnit):
     def audit(self, limit: int = 200, name: str | None = None, kind: str | None = None,
               before_id: int | None = None) -> list[dict[str, Any]]:
         """Audit rows, newest first (``name``: one item, e.g. G54; ``kind``: one kind of data)."""
-        query = select(OffsetAudit).order_by(OffsetAudit.id.desc()).limit(limit)
+        query = (select(OffsetAudit).where(OffsetAudit.machine == self.machine)
+                 .order_by(OffsetAudit.id.desc()).limit(limit))
         if name is not None:
             query = query.where(OffsetAudit.offset == name)
         if kind is not None:
@@ -218,21 +231,27 @@ class Unit(PartsUnit):
 
     def get_audit(self, audit_id: int) -> dict[str, Any] | None:
         row = self._session.get(OffsetAudit, audit_id)
-        return None if row is None else _audit_dict(row)
+        return None if row is None or row.machine != self.machine else _audit_dict(row)
 
     def _frame_rows(self, name: str) -> dict[str, FrameAxis]:
         rows = self._session.scalars(
-            select(FrameAxis).where(FrameAxis.channel == CHANNEL, FrameAxis.name == name)
+            select(FrameAxis).where(FrameAxis.machine == self.machine, FrameAxis.channel == CHANNEL,
+                                    FrameAxis.name == name)
         )
         return {row.axis: row for row in rows}
 
     # --- tools ---------------------------------------------------------------------------
 
     def list_tools(self) -> list[dict[str, Any]]:
-        return [_tool_dict(row) for row in self._session.scalars(select(Tool).order_by(Tool.t))]
+        query = select(Tool).where(Tool.machine == self.machine).order_by(Tool.t)
+        return [_tool_dict(row) for row in self._session.scalars(query)]
+
+    def _key(self, **key: Any) -> dict[str, Any]:
+        """The primary key of a machine-owned row of this machine (``Session.get``)."""
+        return {"machine": self.machine, **key}
 
     def get_tool(self, t: int) -> dict[str, Any] | None:
-        row = self._session.get(Tool, t)
+        row = self._session.get(Tool, self._key(t=t))
         return None if row is None else _tool_dict(row)
 
     def put_tool(self, t: int, data: dict[str, Any], source: str | None = None, detail: dict[str, Any] | None = None) -> dict[str, Any]:
@@ -243,7 +262,7 @@ class Unit(PartsUnit):
         _check_keys(data, TOOL_FIELDS, "tool")
         if "t" in data and data["t"] != t:
             raise ValueError(f"tool data says t={data['t']!r} but is stored as T{t}")
-        row = self._session.get(Tool, t)
+        row = self._session.get(Tool, self._key(t=t))
         current = DEFAULT_TOOL if row is None else _tool_dict(row)
         wear = data.get("wear", {})
         _check_keys(wear, ("length", "radius", "l1", "l2"), "tool wear")
@@ -251,7 +270,7 @@ class Unit(PartsUnit):
         if name is not None and not isinstance(name, str):
             raise ValueError("tool name must be a string or null")
         if row is None:
-            row = Tool(t=t)
+            row = Tool(machine=self.machine, t=t)
             self._session.add(row)
         row.name = name
         row.type = _int(data.get("type", current["type"]), "type")
@@ -268,7 +287,7 @@ class Unit(PartsUnit):
 
     def delete_tool(self, t: int, source: str | None = None) -> None:
         """KeyError when there is no tool ``t``; with ``source`` audited."""
-        row = self._session.get(Tool, t)
+        row = self._session.get(Tool, self._key(t=t))
         if row is None:
             raise KeyError(t)
         before = _tool_dict(row)
@@ -300,7 +319,7 @@ class Unit(PartsUnit):
         return self._list_records(ToolProbe)
 
     def _get_record(self, model: type[_Record], n: int) -> dict[str, Any] | None:
-        row = self._session.get(model, n)
+        row = self._session.get(model, self._key(number=n))
         return None if row is None else copy.deepcopy(row.data)
 
     def _put_record(self, model: type[_Record], n: int, data: dict[str, Any],
@@ -315,10 +334,10 @@ class Unit(PartsUnit):
         calibrated_at = document.get("calibrated_at")
         if calibrated_at is not None and not isinstance(calibrated_at, str):
             raise ValueError("calibrated_at must be an ISO time string or null")
-        row = self._session.get(model, n)
+        row = self._session.get(model, self._key(number=n))
         before = None if row is None else copy.deepcopy(row.data)
         if row is None:
-            row = model(number=n)
+            row = model(machine=self.machine, number=n)
             self._session.add(row)
         row.data, row.calibrated_at = document, calibrated_at
         self._session.flush()
@@ -328,12 +347,13 @@ class Unit(PartsUnit):
         return copy.deepcopy(document)
 
     def _list_records(self, model: type[_Record]) -> list[dict[str, Any]]:
-        return [copy.deepcopy(row.data) for row in self._session.scalars(select(model).order_by(model.number))]
+        query = select(model).where(model.machine == self.machine).order_by(model.number)
+        return [copy.deepcopy(row.data) for row in self._session.scalars(query)]
 
     # --- settings and machine state (key -> JSON value) ---------------------------------
 
     def get_settings(self) -> dict[str, Any]:
-        rows = self._session.scalars(select(Setting).order_by(Setting.key))
+        rows = self._session.scalars(select(Setting).where(Setting.machine == self.machine).order_by(Setting.key))
         return {row.key: copy.deepcopy(row.value) for row in rows}
 
     def put_settings(self, values: dict[str, Any]) -> dict[str, Any]:
@@ -346,7 +366,7 @@ class Unit(PartsUnit):
         return self.get_settings()
 
     def get_state(self, key: str, default: Any = None) -> Any:
-        row = self._session.get(MachineState, key)
+        row = self._session.get(MachineState, self._key(key=key))
         return default if row is None else copy.deepcopy(row.value)
 
     def set_state(self, key: str, value: Any) -> None:
@@ -355,9 +375,9 @@ class Unit(PartsUnit):
 
     def _upsert(self, model: type[_KeyValue], key: str, value: Any) -> None:
         value = _json_ready(value, key)
-        row = self._session.get(model, key)
+        row = self._session.get(model, self._key(key=key))
         if row is None:
-            self._session.add(model(key=key, value=value))
+            self._session.add(model(machine=self.machine, key=key, value=value))
         else:
             row.value = value
 
@@ -365,11 +385,13 @@ class Unit(PartsUnit):
 
     def get_memory(self, kind: str, number: int) -> float:
         """The memory's value; 0 for one never written (the NC's initial value)."""
-        row = self._session.get(MemoryValue, (_memory_kind(kind), _positive_int(number, "memory number")))
+        row = self._session.get(MemoryValue, self._key(kind=_memory_kind(kind),
+                                                       number=_positive_int(number, "memory number")))
         return 0.0 if row is None else float(row.value)
 
     def list_memories(self, kind: str) -> dict[int, float]:
-        rows = self._session.scalars(select(MemoryValue).where(MemoryValue.kind == _memory_kind(kind))
+        rows = self._session.scalars(select(MemoryValue).where(MemoryValue.machine == self.machine,
+                                                               MemoryValue.kind == _memory_kind(kind))
                                      .order_by(MemoryValue.number))
         return {row.number: float(row.value) for row in rows}
 
@@ -378,10 +400,10 @@ class Unit(PartsUnit):
         """Writes the memory and an audit row (offset name "EV10", "MV10"); (before, after)."""
         kind, number = _memory_kind(kind), _positive_int(number, "memory number")
         value = _finite(value, f"{kind}{number}")
-        row = self._session.get(MemoryValue, (kind, number))
+        row = self._session.get(MemoryValue, self._key(kind=kind, number=number))
         before = 0.0 if row is None else float(row.value)
         if row is None:
-            self._session.add(MemoryValue(kind=kind, number=number, value=value))
+            self._session.add(MemoryValue(machine=self.machine, kind=kind, number=number, value=value))
         else:
             row.value = value
         self.add_audit("memory", f"{kind}{number}", {"value": before}, {"value": value}, source, detail)
@@ -392,13 +414,14 @@ class Unit(PartsUnit):
     def list_programs(self) -> list[dict[str, Any]]:
         """Every stored program without its text: name, size (characters, lines), times."""
         rows = self._session.execute(select(Program.name, func.length(Program.text), Program.text,
-                                            Program.created_at, Program.updated_at).order_by(Program.name))
+                                            Program.created_at, Program.updated_at)
+                                     .where(Program.machine == self.machine).order_by(Program.name))
         return [{"name": name, "size": int(size or 0), "lines": text.count("\n") + (1 if text and not
                  text.endswith("\n") else 0), "created_at": created, "updated_at": updated}
                 for name, size, text, created, updated in rows]
 
     def get_program(self, name: str) -> dict[str, Any] | None:
-        row = self._session.get(Program, name)
+        row = self._session.get(Program, self._key(name=name))
         return None if row is None else _program_dict(row)
 
     def put_program(self, name: str, text: str) -> tuple[dict[str, Any], bool]:
@@ -408,10 +431,10 @@ class Unit(PartsUnit):
         if not isinstance(text, str) or len(text) > PROGRAM_TEXT_MAX:
             raise ValueError(f"a program is a text of at most {PROGRAM_TEXT_MAX} characters")
         now = _utc_now()
-        row = self._session.get(Program, name)
+        row = self._session.get(Program, self._key(name=name))
         created = row is None
         if row is None:
-            row = Program(name=name, text=text, created_at=now, updated_at=now)
+            row = Program(machine=self.machine, name=name, text=text, created_at=now, updated_at=now)
             self._session.add(row)
         else:
             row.text, row.updated_at = text, now
@@ -420,7 +443,7 @@ class Unit(PartsUnit):
 
     def delete_program(self, name: str) -> None:
         """KeyError when there is no program ``name``."""
-        row = self._session.get(Program, name)
+        row = self._session.get(Program, self._key(name=name))
         if row is None:
             raise KeyError(name)
         self._session.delete(row)
@@ -432,7 +455,7 @@ class Unit(PartsUnit):
         _check_keys(entry, LOG_FIELDS, "log entry")
         if not isinstance(entry.get("task"), str):
             raise ValueError("log entry needs a task name")
-        row = MeasurementLog(time=_utc_now(), **{key: _json_ready(entry.get(key), key) for key in LOG_FIELDS})
+        row = MeasurementLog(machine=self.machine, time=_utc_now(), **{key: _json_ready(entry.get(key), key) for key in LOG_FIELDS})
         self._session.add(row)
         self._session.flush()
         return row.id
@@ -443,7 +466,7 @@ class Unit(PartsUnit):
         ``before_id``, for paging through all of them); ``fields`` reads only those columns."""
         names = LOG_FIELDS if fields is None else tuple(f for f in LOG_FIELDS if f in set(fields))
         columns = [MeasurementLog.id, MeasurementLog.time, *(getattr(MeasurementLog, f) for f in names)]
-        query = select(*columns).order_by(MeasurementLog.id.desc())
+        query = select(*columns).where(MeasurementLog.machine == self.machine).order_by(MeasurementLog.id.desc())
         if before_id is not None:
             query = query.where(MeasurementLog.id < before_id)
         query = query.offset(offset).limit(limit)
@@ -451,11 +474,12 @@ class Unit(PartsUnit):
                 for row in self._session.execute(query)]
 
     def count_log(self) -> int:
-        return int(self._session.scalar(select(func.count(MeasurementLog.id))) or 0)
+        query = select(func.count(MeasurementLog.id)).where(MeasurementLog.machine == self.machine)
+        return int(self._session.scalar(query) or 0)
 
     def get_log(self, log_id: int) -> dict[str, Any] | None:
         row = self._session.get(MeasurementLog, log_id)
-        return None if row is None else _log_dict(row)
+        return None if row is None or row.machine != self.machine else _log_dict(row)
 
 
     # --- users, API tokens, sign-in sessions (access levels, design.md §9.2) ---------------
@@ -532,13 +556,14 @@ class Unit(PartsUnit):
             user_id = self._session.scalar(select(User.id).where(User.name == user_name))
             if user_id is None:
                 raise KeyError(user_name)
-        self._session.add(AuthSession(id=session_hash, user_id=user_id, created=now, expires=expires))
+        self._session.add(AuthSession(id=session_hash, machine=self.machine, user_id=user_id, created=now,
+                                      expires=expires))
         self._session.flush()
 
     def get_session(self, session_hash: str) -> dict[str, Any] | None:
         """{"user": {...} or None (panel), "expires"} of a session that has not expired."""
         row = self._session.get(AuthSession, session_hash)
-        if row is None or row.expires < _utc_now():
+        if row is None or row.machine != self.machine or row.expires < _utc_now():
             return None
         user = None
         if row.user_id is not None:
@@ -560,9 +585,9 @@ class _EndedTransaction:
 
 # --- row <-> dict helpers -------------------------------------------------------------------
 
-def _new_frame_axis(slot: OffsetSlot, axis: str) -> FrameAxis:
+def _new_frame_axis(slot: OffsetSlot, axis: str, machine: str) -> FrameAxis:
     return FrameAxis(
-        channel=CHANNEL, name=slot.name, kind=slot.kind, frame_index=slot.index, axis=axis,
+        machine=machine, channel=CHANNEL, name=slot.name, kind=slot.kind, frame_index=slot.index, axis=axis,
         coarse=0.0, fine=0.0, rot=0.0 if axis in GEOMETRY_AXES else None, mirror=False, scale=1.0,
     )
 
@@ -629,7 +654,8 @@ def _lathe_fields(data: dict[str, Any], wear: dict[str, Any], current: dict[str,
 def _audit_dict(row: OffsetAudit) -> dict[str, Any]:
     return {"id": row.id, "time": row.time, "kind": row.kind or "offset", "offset": row.offset,
             "before": copy.deepcopy(row.before), "after": copy.deepcopy(row.after), "source": row.source,
-            "detail": copy.deepcopy(row.detail), "who": row.who, "level": row.who_level}
+            "detail": copy.deepcopy(row.detail), "who": row.who, "level": row.who_level,
+            "machine": row.machine}
 
 
 def _user_dict(row: User) -> dict[str, Any]:
@@ -655,8 +681,11 @@ def _memory_kind(kind: str) -> str:
     return kind
 
 
-def _utc_now() -> str:
+def utc_now() -> str:
     return datetime.now(UTC).isoformat(timespec="microseconds")
+
+
+_utc_now = utc_now
 
 
 def _json_ready(value: Any, what: str) -> Any:

@@ -325,6 +325,23 @@ START_GUARD_LIMIT = _define(
     65301, "START_GUARD_LIMIT", "Start guard: the planned path leaves the travel range",
     "启动保护：计划路径超出行程范围",
     "Nothing moved. Start the measurement farther from the axis limits, or shorten the measuring path.")
+# --- probe state at NC Start (design.md §10.4) ----------------------------------------------------
+# Product-defined (840D user alarm range): a measuring task starts only with a probe that can switch.
+PROBE_NOT_ARMED = _define(
+    65400, "PROBE_NOT_ARMED", "Probe not ready: it is not switched on", "测量头未就绪：未开启",
+    "Switch the probe on (radio probe: check or change its battery), press Reset, then NC Start again.")
+PROBE_DEFLECTED = _define(
+    65401, "PROBE_DEFLECTED", "Probe deflected before the start", "启动前测量头已偏转",
+    "Jog the probe clear of the surface and check that the stylus sits free, press Reset, then NC Start again.")
+PROBE_NOT_IN_SPINDLE = _define(
+    65402, "PROBE_NOT_IN_SPINDLE", "The probe is not the tool in the spindle", "测量头不是主轴中的刀具",
+    "Load the workpiece probe into the spindle (tool change), press Reset, then NC Start again.")
+TOOL_PROBE_NOT_ARMED = _define(
+    65403, "TOOL_PROBE_NOT_ARMED", "Tool probe not ready: it is not switched on", "刀具测量头未就绪：未开启",
+    "Switch the tool probe on (radio probe: check or change its battery), press Reset, then NC Start again.")
+TOOL_PROBE_DEFLECTED = _define(
+    65404, "TOOL_PROBE_DEFLECTED", "Tool probe deflected before the start", "启动前刀具测量头已偏转",
+    "Move the tool clear of the tool probe and check that its disc sits free, press Reset, then NC Start again.")
 
 # --- turning cycles: alarms of spec/turning.md §8 the catalogue lacked (seed 001 [L28123–L28133]) ---
 TOOL_ENVIRONMENT = _define(
@@ -352,3 +369,51 @@ OFFSET_OPTION = _define(
 CONTROLLER_ERROR = _define(
     65200, "CONTROLLER_ERROR", "Controller error", "控制器故障",
     "The controller reported an error (its message is the alarm text): correct the cause, then press Reset.")
+
+# --- logging measuring results, CYCLE100..CYCLE118 (manual §7.1, §11; spec measuring-math §15) -----
+PROTOCOL_NO_FILE = _define(
+    61354, "PROTOCOL_NO_FILE", "No data block found for the log file", "未找到用于记录文件的数据块",
+    "Give the log file a name in _PROTNAME[1] before CYCLE100.")
+PROTOCOL_FILE_TYPE = _define(
+    61355, "PROTOCOL_FILE_TYPE", "Wrong data block type for the log file", "用于记录文件的错误数据块类型",
+    "Name the log file with letters, digits and _, starting with two letters or a letter and _.")
+PROTOCOL_JOB = _define(
+    61360, "PROTOCOL_JOB", "Log job not defined - continue with Reset", "未定义记录任务——按复位键继续",
+    "Switch logging on with CYCLE100 first, and call CYCLE105/CYCLE106 with a valid parameter.")
+PROTOCOL_VALUE = _define(
+    61361, "PROTOCOL_VALUE", "Variable cannot be logged", "不能记录变量",
+    "Log only _OVR[n], _OVI[n], R parameters, _TXT[n], _TIME, _AXIS, _AXIS1..3 or text in _PROTVAL[2..5].")
+PROTOCOL_COUNT = _define(
+    61362, "PROTOCOL_COUNT", "Number of values too large", "数量值过大",
+    "CYCLE118 formats at most 10 values: reduce its 4th parameter.")
+PROTOCOL_LINE_LONG = _define(
+    62307, "PROTOCOL_LINE_LONG", "Maximum number of characters per line exceeded", "超过每行的最大字符数",
+    "Raise the characters per line in _PROTFORM[1].")
+PROTOCOL_VARIABLE_WIDTH = _define(
+    62308, "PROTOCOL_VARIABLE_WIDTH", "Variable column width not possible", "可变栏宽不可实现",
+    "Give the column titles in _PROTVAL[0]; the log uses a fixed width of 12 characters meanwhile.")
+PROTOCOL_COLUMN_WIDTH = _define(
+    62309, "PROTOCOL_COLUMN_WIDTH", "Column width insufficient", "栏宽不足",
+    "Widen the columns in _PROTFORM[5] or, with variable widths, the titles in _PROTVAL[0].")
+PROTOCOL_LINE_LIMIT = _define(
+    62310, "PROTOCOL_LINE_LIMIT", "Max. characters per line limited to 200", "每行最大字符数被限制为每行200个字符",
+    "Set _PROTFORM[1] to at most 200.")
+# 65600..65619: this product's numbers for the manual's messages that have none (manual §7.1.2)
+PROTOCOL_NEW_NAME = _define(
+    65600, "PROTOCOL_NEW_NAME", "Please give a new log name", "请给定新的记录名称",
+    "The log file and its 9 continuation files are full: set a new name in _PROTNAME[1] and start again.")
+PROTOCOL_CONTINUED = _define(
+    65601, "PROTOCOL_CONTINUED", "New log file created", "已编制新的记录数据",
+    "Informational: the log goes on in a continuation file (name with _ appended).")
+
+# --- probe health (issue [probe-health], design.md §10.4): product-defined, 65120-65139 -----------
+PROBE_NOT_CALIBRATED = _define(
+    65120, "PROBE_NOT_CALIBRATED", "Probe not calibrated for this measurement", "测量头未针对此测量校准",
+    "Calibrate the probe: the length on a known surface, the radius in the ring gauge.")
+CALIBRATION_INVALID = _define(
+    65121, "CALIBRATION_INVALID", "Probe calibration no longer valid", "测量头校准已失效",
+    "Calibrate the probe again (the probe data screen says what made the calibration invalid).")
+REPEATABILITY_EXCEEDED = _define(
+    65122, "REPEATABILITY_EXCEEDED", "Probe repeatability above the limit", "测量头重复性超出极限",
+    "Clean the probe ball and the surface, check that the stylus is tight, then run the repeatability "
+    "check again.")

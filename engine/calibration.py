@@ -37,7 +37,7 @@ estimator ``estimate_ring`` / ``calibrate_ring`` below (its own derivation; docs
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -52,9 +52,9 @@ from engine.plan_base import RingCalibrationPoint, RingPass
 from engine.planes import PLANES, Plane, axis_index
 from engine.types import EdgePoint, FloatArray, MeasuringError, ProbeRecord
 
-__all__ = ["PRETRAVEL_FRAMES", "RingEstimate", "RingTouch", "calibrate_length", "calibrate_length_point",
-           "calibrate_radius", "calibrate_ring", "calibration_jacobian", "calibration_variances", "estimate_ring",
-           "evaluate_probe_task",
+__all__ = ["PRETRAVEL_FRAMES", "FrameDecision", "RingEstimate", "RingTouch", "calibrate_length",
+           "calibrate_length_point", "calibrate_radius", "calibrate_ring", "calibration_jacobian",
+           "calibration_variances", "choose_pretravel_frame", "estimate_ring", "evaluate_probe_task",
            "ideal_ring_touches", "probe_values", "ring_touches", "setup_noise_bound"]
 
 
@@ -223,8 +223,13 @@ def evaluate_probe_task(task: str, params: dict[str, Any], point: object, probe:
 # it depends on the direction class j(i): the travel angle in the probe's frame θ − φ
 # (pretravel_frame "probe": the lobing turns with the spindle) or in the machine frame θ
 # ("machine", the wave-1 simulator). E_i·d_i = e·q_i with q_i = Rz(−φ_i)·d_i,mcs (the direction
-# seen by the probe). Unknowns: M (2), e (2), ρ_j (one per class); r enters only s(h) and is
-# taken as the nominal radius there (error h²Δr/2(R−r)², sub-nm for h < 0.5 mm).
+# seen by the probe). Unknowns: M (2), e (2), ρ_j (one per class) and the ball radius r, which
+# enters only s(h): ∂s/∂r = 1 − (R−r)/√((R−r)² − h²) ≈ −h²/2(R−r)². Chords at different offsets
+# h within one direction class (the centre search near h = 0, the cal_chords passes at
+# h = ±(R − r)/2) observe r; it is then estimated, so a wrong nominal ball (the tool data the
+# operator typed) does not bias ρ through the sagitta (a 0.1 mm small ball cost 6.2 µm per
+# direction with the nominal in s(h)). Chords near the centre leave r at the nominal, where
+# a wrong one costs at most h²Δr/2(R−r)² (sub-nm for h < 0.5 mm).
 #
 # What is observable (rank of the along-d part; s(h) adds only 2nd-order information):
 #  - probe frame: e and a first harmonic of ρ (ρ_j ← ρ_j − v·(cos θ_j, sin θ_j), e ← e + v)
@@ -337,6 +342,9 @@ class RingEstimate:
     param_names: tuple[str, ...]
     max_chord_offset: float
     notes: tuple[str, ...]
+    ball_diameter: float = 0.0              # the ball diameter the sagittas used: measured or nominal
+    ball_diameter_estimated: bool = False   # True: measured from the chords (RADIUS_MIN_LEVER)
+    ball_diameter_std: float = 0.0
 
     @property
     def rms(self) -> float:
@@ -374,6 +382,8 @@ class RingEstimate:
                            "skew": "eccentricity - k" if self.skew_effective else "eccentricity"},
             "notes": list(self.notes),
             "lobing": self.lobing.values_json(),
+            "ball_diameter": {"value": float(self.ball_diameter), "measured": bool(self.ball_diameter_estimated),
+                              "std": float(self.ball_diameter_std)},
         }
 
 
@@ -408,45 +418,26 @@ def _null_space(c: FloatArray, m: int) -> FloatArray:
     return vt[rank:].T
 
 
-def estimate_ring(touches: Sequence[RingTouch], diameter: float, probe: ProbeRecord, plane: Plane, *,
-                  frame: str = "probe", center: npt.ArrayLike | None = None, skew: npt.ArrayLike | None = None,
-                  wcs2bcs: Frame | None = None,
-                  sigma: float | None = None, first_harmonic: str = "convention") -> RingEstimate:
-    """Ring centre, skew and every direction's effective radius from all touches, least squares.
+@dataclass(frozen=True)
+class _RingDesign:
+    """The touches of a ring calibration in plane coordinates (a, o): latch ``rec``, travel ``d``
+    and its normal ``d_perp`` (WCS), the travel as the probe sees it ``q``/``q_perp`` (machine
+    X/Y turned back by SPOS), the direction in the pre-travel's frame ``theta`` (deg) and SPOS."""
 
-    ``touches``: RingTouch (``ring_touches`` of a RingCalibrationPoint, or any set: n directions
-    at any spindle angles). ``diameter``: the ring's known diameter. ``frame``: where the pre-
-    travel lives, "probe" (turns with SPOS) or "machine" (wave-1 simulator). ``center``: a known
-    ring centre (WCS point or (a, o)), ``skew``: a known skew (machine X/Y at 0°) — both optional,
-    they remove the corresponding unknowns. ``wcs2bcs``: measuring WCS -> BCS (= MCS). ``sigma``:
-    a-priori σ per touch for the covariance (else σ̂ from the residuals). ``first_harmonic``:
-    "convention" (default: the first harmonic of the pre-travel goes into skew resp. centre) or
-    "estimate" (separate it through the chord offsets: needs oblique chords).
+    rec: FloatArray
+    d: FloatArray
+    d_perp: FloatArray
+    q: FloatArray
+    q_perp: FloatArray
+    theta: FloatArray
+    phis: FloatArray
 
-    Model, observability, convention and accuracy: the comment block above this class. Failures:
-    ValueError for bad input; MeasuringError NEEDS_SPOS when one spindle angle leaves centre and
-    skew inseparable, CIRCLE_UNDETERMINED for any other rank defect (e.g. directions on one axis).
-    """
-    if frame not in PRETRAVEL_FRAMES:
-        raise ValueError(f"frame must be one of {PRETRAVEL_FRAMES}, got {frame!r}")
-    big_r = float(diameter) / 2.0
-    if not big_r > 0.0:
-        raise ValueError(f"ring diameter must be > 0, got {diameter}")
-    r_nom = probe.ball_diameter / 2.0
-    a_s = big_r - r_nom
-    if not a_s > 0.0:
-        raise ValueError(f"ring diameter {diameter} must exceed the ball diameter {probe.ball_diameter}")
-    touches = tuple(touches)
+
+def _ring_design(touches: Sequence[RingTouch], plane: Plane, frame: str,
+                 to_mcs: Callable[[FloatArray], FloatArray]) -> _RingDesign:
     n = len(touches)
-    if n < 4:
-        raise MeasuringError(alarms.CIRCLE_PARAMETERS, f"a ring calibration needs 4 or more touches, got {n}")
-    to_mcs = (lambda v: v) if wcs2bcs is None else wcs2bcs.dir_child2parent
-    rec = np.empty((n, 2))
-    d = np.empty((n, 2))
-    q = np.empty((n, 2))
-    q_perp = np.empty((n, 2))
-    theta = np.empty(n)
-    phis = np.empty(n)
+    rec, d, q, q_perp = np.empty((n, 2)), np.empty((n, 2)), np.empty((n, 2)), np.empty((n, 2))
+    theta, phis = np.empty(n), np.empty(n)
     for i, t in enumerate(touches):
         rec[i] = plane.to_aop(np.asarray(t.rec, dtype=float))[:2]
         d_aop = plane.to_aop(_unit2(t.direction))
@@ -463,108 +454,98 @@ def estimate_ring(touches: Sequence[RingTouch], diameter: float, probe: ProbeRec
         theta_m = float(np.degrees(np.arctan2(d_mcs[1], d_mcs[0])))
         theta[i] = theta_m - phi if frame == "probe" else theta_m
         phis[i] = phi % 360.0
-    d_perp = np.column_stack([-d[:, 1], d[:, 0]])
-    class_angles, cls = _classes(theta)
-    m = len(class_angles)
-    n_par = 4 + m
-    names = ("center_a", "center_o", "skew_X", "skew_Y", *[f"rho_{a:g}" for a in class_angles])
+    return _RingDesign(rec, d, np.column_stack([-d[:, 1], d[:, 0]]), q, q_perp, theta, phis)
 
-    # fixed parameters, free ones, convention on the ρ block
-    x_fixed = np.zeros(n_par)
-    free_cols: list[FloatArray] = []
-    if center is None:
-        free_cols += [np.eye(n_par)[:, 0], np.eye(n_par)[:, 1]]
-    else:
-        c_arr = np.asarray(center, dtype=float)
-        x_fixed[:2] = plane.to_aop(c_arr)[:2] if c_arr.shape == (3,) else c_arr[:2]
-    if skew is None:
-        free_cols += [np.eye(n_par)[:, 2], np.eye(n_par)[:, 3]]
-    else:
-        x_fixed[2:4] = np.asarray(skew, dtype=float)[:2]
-    if first_harmonic not in ("convention", "estimate"):
-        raise ValueError(f"first_harmonic must be 'convention' or 'estimate', got {first_harmonic!r}")
-    constrained = (frame == "probe" and skew is None) or (frame == "machine" and center is None)
-    th_rad = np.radians(class_angles)
-    harmonic = np.vstack([np.cos(th_rad), np.sin(th_rad)])
-    null = _null_space(harmonic, m) if constrained else np.eye(m)
-    t_mat = np.column_stack(free_cols + [np.concatenate([np.zeros(4), col]) for col in null.T])
-    t_full = np.column_stack(free_cols + [np.concatenate([np.zeros(4), col]) for col in np.eye(m)])
 
-    onehot = np.zeros((n, m))
-    onehot[np.arange(n), cls] = 1.0
+class _RingModel:
+    """Residual along each touch's travel and its Jacobian (the model in the comment block above).
 
-    def residual_jac(x: FloatArray, sagitta: bool = True) -> tuple[FloatArray, FloatArray]:
-        mc, e, rho = x[:2], x[2:4], x[4:]
-        w = rec - mc
-        h = np.sum(w * d_perp, axis=1) + q_perp @ e
+    Parameters x = (M_a, M_o, e_X, e_Y, ρ_1..ρ_m, r): ring centre, skew at SPOS 0°, the effective
+    radius of each direction class, and the ball radius r, which enters only the sagitta
+    s(h) = √((R − r)² − h²) − (R − r) of a chord h off the centre (∂f/∂r = (R − r)/√(…) − 1)."""
+
+    def __init__(self, design: _RingDesign, classes: FloatArray, m: int, big_r: float):
+        self.design, self.big_r, self.m = design, big_r, m
+        self.classes = classes
+        n = len(classes)
+        self.onehot = np.zeros((n, m))
+        self.onehot[np.arange(n), classes] = 1.0
+
+    @property
+    def n_par(self) -> int:
+        return 5 + self.m
+
+    def chord_offsets(self, x: FloatArray) -> FloatArray:
+        g = self.design
+        return np.asarray(np.sum((g.rec - x[:2]) * g.d_perp, axis=1) + g.q_perp @ x[2:4], dtype=float)
+
+    def residual_jac(self, x: FloatArray, sagitta: bool = True) -> tuple[FloatArray, FloatArray]:
+        g = self.design
+        mc, e, rho, r = x[:2], x[2:4], x[4:4 + self.m], float(x[4 + self.m])
+        a_s = self.big_r - r
+        h = self.chord_offsets(x)
+        n = len(h)
         if sagitta:
             if np.any(np.abs(h) >= a_s):
                 raise MeasuringError(alarms.CIRCLE_UNDETERMINED, "ring touches miss the ring (chord offset)")
             root = np.sqrt(a_s * a_s - h * h)
-            s, ds = root - a_s, -h / root
+            s, ds, ds_r = root - a_s, -h / root, a_s / root - 1.0
         else:
-            s, ds = np.zeros(n), np.zeros(n)
-        f = np.sum(w * d, axis=1) + q @ e - (big_r - rho[cls]) - s
-        jac = np.column_stack([-d + ds[:, None] * d_perp, q - ds[:, None] * q_perp, onehot])
+            s, ds, ds_r = np.zeros(n), np.zeros(n), np.zeros(n)
+        f = np.sum((g.rec - mc) * g.d, axis=1) + g.q @ e - (self.big_r - rho[self.classes]) - s
+        jac = np.column_stack([-g.d + ds[:, None] * g.d_perp, g.q - ds[:, None] * g.q_perp, self.onehot, ds_r])
         return f, jac
 
-    # linear start (s = 0), then Gauss-Newton with the chord offsets
-    f0, j0 = residual_jac(x_fixed, sagitta=False)
-    jz = j0 @ t_mat
+
+def _rank_ok(jz: FloatArray) -> bool:
     sv = np.linalg.svd(jz, compute_uv=False)
-    if len(sv) < t_mat.shape[1] or sv[-1] <= 1e-9 * max(1.0, sv[0]):
-        if len(set(np.round(phis, 6))) < 2 and center is None and skew is None:
-            raise MeasuringError(alarms.NEEDS_SPOS, "ring centre and skew cannot be told apart at one spindle "
-                                 "orientation: calibrate at 0° and 180° (SPOS), or give the centre")
-        raise MeasuringError(alarms.CIRCLE_UNDETERMINED, "the ring touches do not determine centre, skew "
-                             "and trigger values (directions must span the plane)")
-    z, *_ = np.linalg.lstsq(jz, -f0, rcond=None)
-    x = x_fixed + t_mat @ z
-    for _ in range(30):      # the chord term is a small correction: 2–4 steps to rounding
-        f, jac = residual_jac(x)
+    return bool(len(sv) == jz.shape[1] and sv[-1] > 1e-9 * max(1.0, sv[0]))
+
+
+def _gauss_newton(model: _RingModel, x: FloatArray, t_mat: FloatArray) -> FloatArray:
+    """Σ f² over the columns of ``t_mat``; the chord term is a small correction: 2–4 steps."""
+    for _ in range(30):
+        f, jac = model.residual_jac(x)
         step, *_ = np.linalg.lstsq(jac @ t_mat, -f, rcond=None)
         x = x + t_mat @ step
-        if np.linalg.norm(step) <= 1e-13 * max(big_r, 1.0):
+        if np.linalg.norm(step) <= 1e-13 * max(model.big_r, 1.0):
             break
-    if constrained and first_harmonic == "estimate":
-        # the chord offsets carry the first harmonic apart from skew (probe frame) or centre
-        # (machine frame): Gauss-Newton on the full model from the convention's solution
-        f, jac = residual_jac(x)
-        sv = np.linalg.svd(jac @ t_full, compute_uv=False)
-        if len(sv) < t_full.shape[1] or sv[-1] <= 1e-9 * max(1.0, sv[0]):
-            raise MeasuringError(alarms.CIRCLE_UNDETERMINED, "skew and the first harmonic of the pre-travel "
-                                 "cannot be told apart: probe chords off the ring centre (oblique incidence)")
-        t_mat, constrained = t_full, False
-        for _ in range(30):
-            f, jac = residual_jac(x)
-            step, *_ = np.linalg.lstsq(jac @ t_mat, -f, rcond=None)
-            x = x + t_mat @ step
-            if np.linalg.norm(step) <= 1e-13 * max(big_r, 1.0):
-                break
-    f, jac = residual_jac(x)
+    return x
+
+
+def _free_columns(n_par: int, m: int, center: object, skew: object, null: FloatArray,
+                  radius_free: bool) -> FloatArray:
+    """The free directions of the parameter space: centre and skew unless given, the ρ block
+    (``null``: its convention), the ball radius when the chords observe it."""
+    eye = np.eye(n_par)
+    cols = ([eye[:, 0], eye[:, 1]] if center is None else []) + ([eye[:, 2], eye[:, 3]] if skew is None else [])
+    cols += [np.concatenate([np.zeros(4), col, [0.0]]) for col in null.T]
+    if radius_free:
+        cols.append(eye[:, n_par - 1])
+    return np.column_stack(cols)
+
+
+# The ball radius is estimated when the chords observe it to within this many σ of one touch
+# (std of r̂ ≤ σ/lever): chords halfway out (h = (R − r)/2, the cal_chords program) give ≈ 3.6σ;
+# centre chords (|h| < 1 mm) leave it at the nominal, where a wrong nominal costs ≤ h²Δr/2(R−r)².
+RADIUS_MIN_LEVER = 0.1
+
+
+def _radius_lever(model: _RingModel, x: FloatArray, t_mat: FloatArray) -> float:
+    """Norm of the ball-radius column left after the other free columns explain what they can."""
+    _f, jac = model.residual_jac(x)
     jz = jac @ t_mat
-    dof = n - t_mat.shape[1]
-    if sigma is not None:
-        s_used = float(sigma)
-    elif dof > 0:
-        s_used = float(np.sqrt(np.sum(f * f) / dof))
-    else:
-        s_used = float("nan")
-    cov = None
-    if np.isfinite(s_used):
-        cov_z = s_used * s_used * np.linalg.inv(jz.T @ jz)
-        cov = t_mat @ cov_z @ t_mat.T
-        cov = 0.5 * (cov + cov.T)
+    col = jac[:, -1]
+    coef, *_ = np.linalg.lstsq(jz, col, rcond=None)
+    return float(np.linalg.norm(col - jz @ coef))
 
-    mc, e, rho = x[:2], x[2:4], x[4:]
-    axial = abs(centre_trigger_value(probe, -plane.infeed_unit, plane))
-    lobing = fit_lobing_map(class_angles, rho, frame=frame, skew=e,
-                            covariance=None if cov is None else cov[4:, 4:],
-                            include_first=not constrained, axial_radius=axial)
 
-    def spread(c: FloatArray) -> float:
-        return float("nan") if cov is None else float(np.sqrt(max(c @ cov @ c, 0.0)))
-
+def _key_triggers(lobing: LobingMap, rho: FloatArray, plane: Plane, to_mcs: Callable[[FloatArray], FloatArray],
+                  spread: Callable[[FloatArray], float], n_par: int
+                  ) -> tuple[dict[str, float], dict[str, float], dict[str, float]]:
+    """The record's trigger values for ±1st/±2nd plane axis at SPOS 0° (t(+) = −ρ, t(−) = +ρ,
+    jog-measuring §5.1), their std and the std of the correction e·q + ρ a later touch inherits."""
+    m = len(rho)
     trigger: dict[str, float] = {}
     trigger_std: dict[str, float] = {}
     surface_std: dict[str, float] = {}
@@ -572,20 +553,19 @@ def estimate_ring(touches: Sequence[RingTouch], diameter: float, probe: ProbeRec
         for sign in (1.0, -1.0):
             key = f"{axis}{'+' if sign > 0 else '-'}"
             d_mcs = to_mcs(sign * plane.unit(axis))
-            theta_key = lobing.frame_angle(d_mcs, 0.0)
-            w = lobing.weights(theta_key)
+            w = lobing.weights(lobing.frame_angle(d_mcs, 0.0))
             rho_key = float(w @ rho)
             trigger[key] = -rho_key if sign > 0 else rho_key
-            c_rho = np.concatenate([np.zeros(4), w])
+            c_rho = np.concatenate([np.zeros(4), w, np.zeros(n_par - 4 - m)])
             trigger_std[key] = spread(c_rho)
-            surface_std[key] = spread(c_rho + np.concatenate([[0.0, 0.0], d_mcs[:2], np.zeros(m)]))
-    w0 = np.concatenate([np.zeros(4), lobing.weights_mean()])
-    d_eff = 2.0 * lobing.mean_radius
-    h_all = np.sum((rec - mc) * d_perp, axis=1) + q_perp @ e
+            c_skew = np.concatenate([[0.0, 0.0], d_mcs[:2], np.zeros(n_par - 4)])
+            surface_std[key] = spread(c_rho + c_skew)
+    return trigger, trigger_std, surface_std
 
+
+def _ring_notes(frame: str, first_harmonic: str, skew_effective: bool, center_observable: bool,
+                constrained: bool, max_h: float, a_s: float, radius_free: bool, r_nom: float, r_hat: float) -> list[str]:
     notes = []
-    center_observable = not (frame == "machine" and center is None) or not constrained
-    skew_effective = frame == "probe" and skew is None and constrained
     if first_harmonic == "estimate":
         notes.append("first harmonic of the pre-travel estimated from the chord offsets (oblique "
                      "incidence): skew is the eccentricity, X+ and X− are stored apart")
@@ -599,16 +579,134 @@ def estimate_ring(touches: Sequence[RingTouch], diameter: float, probe: ProbeRec
                      "axes): not separable from the centre in a ring of unknown centre; the trigger "
                      "values are the symmetric parts and later positions probed along ±j are off by "
                      "k_j. Calibrate with a known centre (centre=...) to store X+ and X− apart")
-    if constrained and float(np.max(np.abs(h_all))) > 0.0:
-        notes.append(f"chord offsets up to {float(np.max(np.abs(h_all))):.4f} mm: an unobservable k "
-                     f"leaks into the sagitta term by at most |k|·{float(np.max(np.abs(h_all))) / a_s:.2e}")
+    if constrained and max_h > 0.0:
+        notes.append(f"chord offsets up to {max_h:.4f} mm: an unobservable k "
+                     f"leaks into the sagitta term by at most |k|·{max_h / a_s:.2e}")
+    if radius_free:
+        notes.append(f"ball diameter {2.0 * r_hat:.4f} mm measured from the chord sagittas "
+                     f"(nominal {2.0 * r_nom:.4f} mm)")
+    return notes
+
+
+def estimate_ring(touches: Sequence[RingTouch], diameter: float, probe: ProbeRecord, plane: Plane, *,
+                  frame: str = "probe", center: npt.ArrayLike | None = None, skew: npt.ArrayLike | None = None,
+                  wcs2bcs: Frame | None = None,
+                  sigma: float | None = None, first_harmonic: str = "convention",
+                  ball: str = "auto") -> RingEstimate:
+    """Ring centre, skew, every direction's effective radius and (when the chords observe it)
+    the ball radius from all touches, least squares.
+
+    ``touches``: RingTouch (``ring_touches`` of a RingCalibrationPoint, or any set: n directions
+    at any spindle angles). ``diameter``: the ring's known diameter. ``frame``: where the pre-
+    travel lives, "probe" (turns with SPOS) or "machine" (wave-1 simulator). ``center``: a known
+    ring centre (WCS point or (a, o)), ``skew``: a known skew (machine X/Y at 0°) — both optional,
+    they remove the corresponding unknowns. ``wcs2bcs``: measuring WCS -> BCS (= MCS). ``sigma``:
+    a-priori σ per touch for the covariance (else σ̂ from the residuals). ``first_harmonic``:
+    "convention" (default: the first harmonic of the pre-travel goes into skew resp. centre) or
+    "estimate" (separate it through the chord offsets: needs oblique chords). ``ball``: "auto"
+    (estimate the ball radius when the chords observe it, RADIUS_MIN_LEVER, else the nominal)
+    or "nominal" (``probe.ball_diameter``; the nominal is the start value either way).
+
+    Model, observability, convention and accuracy: the comment block above this class. Failures:
+    ValueError for bad input; MeasuringError NEEDS_SPOS when one spindle angle leaves centre and
+    skew inseparable, CIRCLE_UNDETERMINED for any other rank defect (e.g. directions on one axis).
+    """
+    if frame not in PRETRAVEL_FRAMES:
+        raise ValueError(f"frame must be one of {PRETRAVEL_FRAMES}, got {frame!r}")
+    if first_harmonic not in ("convention", "estimate"):
+        raise ValueError(f"first_harmonic must be 'convention' or 'estimate', got {first_harmonic!r}")
+    if ball not in ("auto", "nominal"):
+        raise ValueError(f"ball must be 'auto' or 'nominal', got {ball!r}")
+    big_r = float(diameter) / 2.0
+    if not big_r > 0.0:
+        raise ValueError(f"ring diameter must be > 0, got {diameter}")
+    r_nom = probe.ball_diameter / 2.0
+    if not big_r - r_nom > 0.0:
+        raise ValueError(f"ring diameter {diameter} must exceed the ball diameter {probe.ball_diameter}")
+    touches = tuple(touches)
+    n = len(touches)
+    if n < 4:
+        raise MeasuringError(alarms.CIRCLE_PARAMETERS, f"a ring calibration needs 4 or more touches, got {n}")
+    to_mcs: Callable[[FloatArray], FloatArray] = (lambda v: v) if wcs2bcs is None else wcs2bcs.dir_child2parent
+    design = _ring_design(touches, plane, frame, to_mcs)
+    class_angles, cls = _classes(design.theta)
+    m = len(class_angles)
+    model = _RingModel(design, cls, m, big_r)
+    names = ("center_a", "center_o", "skew_X", "skew_Y", *[f"rho_{a:g}" for a in class_angles], "ball_radius")
+
+    # fixed parameters (a given centre/skew, the nominal ball radius) and the convention on ρ
+    x_fixed = np.zeros(model.n_par)
+    x_fixed[-1] = r_nom
+    if center is not None:
+        c_arr = np.asarray(center, dtype=float)
+        x_fixed[:2] = plane.to_aop(c_arr)[:2] if c_arr.shape == (3,) else c_arr[:2]
+    if skew is not None:
+        x_fixed[2:4] = np.asarray(skew, dtype=float)[:2]
+    constrained = (frame == "probe" and skew is None) or (frame == "machine" and center is None)
+    th_rad = np.radians(class_angles)
+    null = _null_space(np.vstack([np.cos(th_rad), np.sin(th_rad)]), m) if constrained else np.eye(m)
+    t_mat = _free_columns(model.n_par, m, center, skew, null, radius_free=False)
+
+    # linear start (s = 0), then Gauss-Newton with the chord offsets
+    f0, j0 = model.residual_jac(x_fixed, sagitta=False)
+    if not _rank_ok(j0 @ t_mat):
+        if len(set(np.round(design.phis, 6))) < 2 and center is None and skew is None:
+            raise MeasuringError(alarms.NEEDS_SPOS, "ring centre and skew cannot be told apart at one spindle "
+                                 "orientation: calibrate at 0° and 180° (SPOS), or give the centre")
+        raise MeasuringError(alarms.CIRCLE_UNDETERMINED, "the ring touches do not determine centre, skew "
+                             "and trigger values (directions must span the plane)")
+    z, *_ = np.linalg.lstsq(j0 @ t_mat, -f0, rcond=None)
+    x = _gauss_newton(model, x_fixed + t_mat @ z, t_mat)
+    if constrained and first_harmonic == "estimate":
+        # the chord offsets carry the first harmonic apart from skew (probe frame) or centre
+        # (machine frame): Gauss-Newton on the full model from the convention's solution
+        t_full = _free_columns(model.n_par, m, center, skew, np.eye(m), radius_free=False)
+        _f, jac = model.residual_jac(x)
+        if not _rank_ok(jac @ t_full):
+            raise MeasuringError(alarms.CIRCLE_UNDETERMINED, "skew and the first harmonic of the pre-travel "
+                                 "cannot be told apart: probe chords off the ring centre (oblique incidence)")
+        t_mat, constrained, null = t_full, False, np.eye(m)
+        x = _gauss_newton(model, x, t_mat)
+    radius_free = ball == "auto" and _radius_lever(model, x, t_mat) >= RADIUS_MIN_LEVER
+    if radius_free:        # the chord sagittas observe the ball: the nominal is only the start value
+        t_mat = _free_columns(model.n_par, m, center, skew, null, radius_free=True)
+        x = _gauss_newton(model, x, t_mat)
+
+    f, jac = model.residual_jac(x)
+    jz = jac @ t_mat
+    dof = n - t_mat.shape[1]
+    s_used = float(sigma) if sigma is not None else (float(np.sqrt(np.sum(f * f) / dof)) if dof > 0 else float("nan"))
+    cov = None
+    if np.isfinite(s_used):
+        cov = t_mat @ (s_used * s_used * np.linalg.inv(jz.T @ jz)) @ t_mat.T
+        cov = 0.5 * (cov + cov.T)
+
+    mc, e, rho, r_hat = x[:2], x[2:4], x[4:4 + m], float(x[-1])
+    axial = abs(centre_trigger_value(probe, -plane.infeed_unit, plane))
+    lobing = fit_lobing_map(class_angles, rho, frame=frame, skew=e,
+                            covariance=None if cov is None else cov[4:4 + m, 4:4 + m],
+                            include_first=not constrained, axial_radius=axial)
+
+    def spread(c: FloatArray) -> float:
+        return float("nan") if cov is None else float(np.sqrt(max(float(c @ cov @ c), 0.0)))
+
+    trigger, trigger_std, surface_std = _key_triggers(lobing, rho, plane, to_mcs, spread, model.n_par)
+    w0 = np.concatenate([np.zeros(4), lobing.weights_mean(), [0.0]])
+    max_h = float(np.max(np.abs(model.chord_offsets(x))))
+    center_observable = not (frame == "machine" and center is None) or not constrained
+    skew_effective = frame == "probe" and skew is None and constrained
+    notes = _ring_notes(frame, first_harmonic, skew_effective, center_observable, constrained, max_h,
+                        big_r - r_nom, radius_free, r_nom, r_hat)
     return RingEstimate(
         frame=frame, diameter=float(diameter), plane_axes=(plane.first, plane.second), center=mc.copy(),
         center_observable=center_observable, skew=e.copy(), skew_effective=skew_effective,
         angles=class_angles, radii=rho.copy(), lobing=lobing, trigger=trigger, trigger_std=trigger_std,
-        surface_std=surface_std, effective_diameter=d_eff, effective_diameter_std=2.0 * spread(w0),
+        surface_std=surface_std, effective_diameter=2.0 * lobing.mean_radius,
+        effective_diameter_std=2.0 * spread(w0),
         residuals=f, form_error=float(f.max() - f.min()), n=n, dof=dof, sigma=s_used, covariance=cov,
-        param_names=names, max_chord_offset=float(np.max(np.abs(h_all))), notes=tuple(notes))
+        param_names=names, max_chord_offset=max_h, notes=tuple(notes),
+        ball_diameter=2.0 * r_hat, ball_diameter_estimated=radius_free,
+        ball_diameter_std=2.0 * spread(np.eye(model.n_par)[-1]) if radius_free else 0.0)
 
 
 def calibrate_ring(point: RingCalibrationPoint, probe: ProbeRecord, plane: Plane,
@@ -619,15 +717,22 @@ def calibrate_ring(point: RingCalibrationPoint, probe: ProbeRecord, plane: Plane
     Same inputs and the same result keys (``center``, ``skew``, ``trigger``,
     ``trigger_difference``, ``effective_diameter``, ``effective_diameter_difference``) plus
     ``std``, ``residuals``, ``rms``, ``form_error``, ``n``, ``sigma_hat``, ``pretravel_frame``,
-    ``observable``, ``notes`` and ``lobing`` (RingEstimate.values_json). ``frame``: "probe"
-    (default: the real probe and the wave-2 simulator) or "machine" (wave-1). ``center``: a
+    ``observable``, ``notes``, ``lobing``, ``ball_diameter`` (RingEstimate.values_json) and
+    ``pretravel_frame_decision``. ``frame``: "probe" (default: the real probe and the wave-2
+    simulator), "machine" (wave-1) or "auto" (choose_pretravel_frame, fallback "probe"). ``center``: a
     known ring centre (WCS), optional. ``first_harmonic``: as estimate_ring ("estimate" with a
     ring_program chord_offset). The record gets the trigger values of ±1st/±2nd axis,
     the skew (machine X/Y at 0°) and the effective diameter 2·c0 (mean over all directions;
     the 4-direction value equals calibrate_radius's 2·mean|t|).
     """
-    est = estimate_ring(ring_touches(point, plane), point.diameter, probe, plane, frame=frame,
-                        center=center, wcs2bcs=wcs2bcs, sigma=sigma, first_harmonic=first_harmonic)
+    touches = ring_touches(point, plane)
+    decision = None
+    if frame == "auto":
+        est, decision = choose_pretravel_frame(touches, point.diameter, probe, plane, center=center,
+                                               wcs2bcs=wcs2bcs, sigma=sigma, first_harmonic=first_harmonic)
+    else:
+        est = estimate_ring(touches, point.diameter, probe, plane, frame=frame,
+                            center=center, wcs2bcs=wcs2bcs, sigma=sigma, first_harmonic=first_harmonic)
     for key, value in est.trigger.items():
         if (value < 0.0) != key.endswith("+") or value == 0.0:
             raise MeasuringError(alarms.SAFE_AREA, f"trigger value {key} = {value:.4f} has the wrong sign: "
@@ -641,7 +746,76 @@ def calibrate_ring(point: RingCalibrationPoint, probe: ProbeRecord, plane: Plane
                                     for k, v in est.trigger.items()}
     values["effective_diameter_difference"] = (None if probe.effective_diameter <= 0.0
                                                else float(est.effective_diameter - probe.effective_diameter))
+    values["pretravel_frame_decision"] = (decision.values_json() if decision is not None
+                                          else {"frame": frame, "decided": False, "margin": None, "rss": {}})
     return record, values
+
+
+# --- does the pre-travel turn with the spindle? (issue [probe-health] item 5) ----------------
+#
+# The two models differ only where a spindle angle other than 0° meets an asymmetric pre-travel:
+# in the probe frame the 180° pass sees the lobing turned by 180°, in the machine frame it does
+# not. With chords through the centre both explain the latches equally (the first harmonic k goes
+# into skew or centre alike: same stored values, nothing to decide); off-centre chords separate
+# them, and a wrong choice leaves k in every later position (the issue's 3.3×/6.2× the noise
+# bound). So both are fitted and compared by their residuals: Akaike's criterion
+# Σf²/σ² + 2p with σ the a-priori noise or the better fit's σ̂ (at least 1 nm, the latch
+# resolution), decided when the worse model's criterion is larger by DECISION_MARGIN (≈ 3σ).
+
+DECISION_MARGIN = 9.0
+_SIGMA_FLOOR = 1e-6         # mm: below this the residuals are rounding, not evidence
+
+
+@dataclass(frozen=True)
+class FrameDecision:
+    """Which pre-travel model the ring data support: ``frame`` (used), ``decided`` (the data
+    told; False: they fit both within the noise, or only one could be fitted, and ``frame`` is
+    the fallback), ``margin`` (criterion of the other model minus the chosen one), ``rss``."""
+
+    frame: str
+    decided: bool
+    margin: float
+    rss: dict[str, float]
+
+    def values_json(self) -> dict[str, Any]:
+        return {"frame": self.frame, "decided": self.decided,
+                "margin": None if not np.isfinite(self.margin) else float(self.margin),
+                "rss": {k: float(v) for k, v in self.rss.items()}}
+
+
+def choose_pretravel_frame(touches: Sequence[RingTouch], diameter: float, probe: ProbeRecord, plane: Plane, *,
+                           fallback: str = "probe", sigma: float | None = None, **kwargs: Any
+                           ) -> tuple[RingEstimate, FrameDecision]:
+    """``estimate_ring`` in both pre-travel frames; the estimate of the model the data support
+    (comment block above) and the decision. ``fallback``: the frame used when they cannot tell.
+    ``kwargs``: the other estimate_ring arguments (center, wcs2bcs, first_harmonic, ...)."""
+    if fallback not in PRETRAVEL_FRAMES:
+        raise ValueError(f"fallback must be one of {PRETRAVEL_FRAMES}, got {fallback!r}")
+    fits: dict[str, RingEstimate] = {}
+    failure: MeasuringError | None = None
+    for frame in PRETRAVEL_FRAMES:
+        try:
+            fits[frame] = estimate_ring(touches, diameter, probe, plane, frame=frame, sigma=sigma, **kwargs)
+        except MeasuringError as exc:
+            failure = exc if frame == fallback or failure is None else failure
+    if not fits and failure is not None:
+        raise failure
+    rss = {f: float(np.sum(est.residuals ** 2)) for f, est in fits.items()}
+    if len(fits) == 1:
+        (only,) = fits
+        return fits[only], FrameDecision(only, False, float("nan"), rss)
+    best_dof = {f: est.dof for f, est in fits.items()}
+    lowest = min(rss, key=lambda f: rss[f])
+    noise = float(sigma) if sigma is not None else (
+        np.sqrt(rss[lowest] / best_dof[lowest]) if best_dof[lowest] > 0 else 0.0)
+    noise = max(noise, _SIGMA_FLOOR)
+    score = {f: rss[f] / noise ** 2 + 2.0 * (est.n - est.dof) for f, est in fits.items()}
+    best = min(score, key=lambda f: score[f])
+    other = next(f for f in fits if f != best)
+    margin = score[other] - score[best]
+    if margin > DECISION_MARGIN:
+        return fits[best], FrameDecision(best, True, margin, rss)
+    return fits[fallback], FrameDecision(fallback, False, margin, rss)
 
 
 # --- the noise bound of a calibrated set-up (docs/noise-bound.md) ----------------------------

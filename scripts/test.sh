@@ -21,6 +21,10 @@ fi
 if [ ! -d /usr/share/fonts/truetype/wqy ]; then
     apt_install --no-install-recommends fonts-wqy-microhei
 fi
+# PostgreSQL for the plant mode's tests (tests/pgcluster.py starts a private cluster, stops it after)
+if ! ls /usr/lib/postgresql/*/bin/initdb >/dev/null 2>&1; then
+    apt_install --no-install-recommends postgresql
+fi
 if [ ! -x .venv/bin/python ]; then
     python3 -m venv .venv
 fi

@@ -37,10 +37,47 @@
       cell.textContent = fixed(value / parseFloat(cell.dataset.scale || "1"), parseInt(cell.dataset.decimals || "3", 10));
     });
   }
-  // what the header, the position block's T/F/SP/State table and the alarm pane show
+  // the probes' lamps and the running probe test (design.md §10.4), painted at once from the event
+  // (the screen shows "switched" within milliseconds; the blocks are fetched again after it)
+  function lampState(p, which) {
+    if (!p) return "none";
+    if (p.deflected) return "deflected";
+    if (p.deflected === null) return "unknown";
+    if (which === "workpiece" && !p.in_spindle) return "absent";
+    if (p.armed === false) return "off";
+    return "ready";
+  }
+  function showText(box, name, state) {
+    var text = box.querySelector(name);
+    var key = "text" + state.split(/[-_]/).map(function (w) { return w.charAt(0).toUpperCase() + w.slice(1); }).join("");
+    if (text && box.dataset[key]) text.textContent = box.dataset[key];
+  }
+  function showProbes(state) {
+    document.querySelectorAll("[data-probe-lamp]").forEach(function (lamp) {
+      var which = lamp.dataset.probeLamp;
+      var now = lampState(which === "tool" ? state.tool_probe : state.probe, which);
+      if (lamp.dataset.state === now) return;
+      lamp.classList.remove("lamp-" + lamp.dataset.state);
+      lamp.classList.add("lamp-" + now);
+      lamp.dataset.state = now;
+      showText(lamp, ".lamp-text", now);
+    });
+    var test = document.getElementById("probe-test");
+    if (!test) return;
+    var probe = test.dataset.probe === "tool" ? state.tool_probe : state.probe;
+    var next = null;
+    if (test.dataset.state === "waiting" && probe && probe.deflected) next = "switched";
+    else if (test.dataset.state === "switched" && probe && probe.deflected === false) next = "passed";
+    if (!next) return;
+    test.classList.remove("test-" + test.dataset.state);
+    test.classList.add("test-" + next);
+    test.dataset.state = next;
+    showText(test, ".test-text", next);
+  }
+  // what the header, the position block's T/F/SP/State table, the alarm pane and the probe pane show
   function machineSignature(s) {
     return JSON.stringify([s.mode, s.active_offset, s.plane, s.tool, s.tool_length, s.feed_override,
-                           s.spindle_angle, s.busy, s.program_state, s.alarms]);
+                           s.spindle_angle, s.busy, s.program_state, s.alarms, s.probe, s.tool_probe]);
   }
   function sessionSignature(s) {
     return JSON.stringify([s.id, s.running, s.progress, s.alarm, s.points, s.notice, s.answer && s.answer.log_id]);
@@ -56,6 +93,29 @@
     document.addEventListener(name, function () { machineSig = sessionSig = null; });
   });
 
+  // the mode group (issue 24 §4): what runs (status.lock) greys out what it locks, and says why
+  function showLock(state) {
+    var lock = state.lock || null;
+    var program = lock && lock.mode !== "JOG" ? lock : null;
+    var mcp = document.getElementById("mcp");
+    if (mcp) {
+      mcp.classList.toggle("locked", !!program);
+      mcp.querySelectorAll(".key.jog").forEach(function (key) { key.disabled = !!program; });
+      var note = document.getElementById("mcp-lock");
+      if (note) {
+        note.hidden = !program;
+        note.querySelector(".lock-program").textContent = program ? program.mode + " " + program.program : "";
+      }
+    }
+    var start = document.getElementById("mda-start");
+    if (start) start.disabled = !!(lock && lock.mode === "JOG");
+    var jogNote = document.getElementById("mda-lock");
+    if (jogNote) {
+      jogNote.hidden = !(lock && lock.mode === "JOG");
+      jogNote.querySelector(".lock-program").textContent = lock && lock.mode === "JOG" ? lock.program : "";
+    }
+  }
+
   // the tab's id (static/hmi.js): the server stops this tab's held jog when the feed drops
   var tab = window.hmiTabId ? window.hmiTabId() : "";
   var source = new EventSource(tab ? url + (url.indexOf("?") < 0 ? "?" : "&") + "tab=" + encodeURIComponent(tab) : url);
@@ -64,6 +124,8 @@
     seen();
     var state = JSON.parse(event.data);
     showPositions(state);
+    showLock(state);
+    showProbes(state);
     var sig = machineSignature(state);
     machineSig = changed(machineSig, sig, "hmi-state");
     if (sessionSig === null && lastSession !== null) sessionSig = changed(null, lastSession, "hmi-session");

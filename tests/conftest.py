@@ -3,11 +3,52 @@
 from __future__ import annotations
 
 import json
+import os
 
 import pytest
 from fastapi.testclient import TestClient
 from hmi_testdata import TEST_SCENARIO, test_scenario
 from live import CHROMIUM_ARGS, browser_tab, serve
+from pgcluster import database_settings
+
+# --- the database engine: SQLite by default, PostgreSQL with --db-engine=postgresql ------------
+
+def pytest_addoption(parser):
+    parser.addoption("--db-engine", choices=("sqlite", "postgresql"),
+                     default=os.environ.get("HMI_TEST_DB_ENGINE", "sqlite"),
+                     help="run the database, repository and app tests on this engine (postgresql: a private "
+                          "cluster of Debian's postgresql, started and stopped by the tests)")
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "sqlite_only: reads the SQLite file itself (skipped on PostgreSQL)")
+
+
+def pytest_collection_modifyitems(config, items):
+    if config.getoption("--db-engine") == "postgresql":
+        skip = pytest.mark.skip(reason="reads the SQLite file itself")
+        for item in items:
+            if "sqlite_only" in item.keywords:
+                item.add_marker(skip)
+
+
+@pytest.fixture(scope="session")
+def pg_cluster():
+    """A private PostgreSQL cluster for the session (tests/pgcluster.py); stopped at the end."""
+    from pgcluster import PgCluster, available
+
+    if not available():
+        pytest.skip("PostgreSQL is not installed (scripts/test.sh installs Debian's postgresql)")
+    with PgCluster() as cluster:
+        yield cluster
+
+
+@pytest.fixture
+def database_target(request, tmp_path):
+    """Where a test's database lives: a SQLite file, or a new database in the private cluster."""
+    if request.config.getoption("--db-engine") == "postgresql":
+        return request.getfixturevalue("pg_cluster").new_database()
+    return tmp_path / "data" / "hmi.db"
 
 
 @pytest.fixture
@@ -18,12 +59,12 @@ def scenario_file(tmp_path):
 
 
 @pytest.fixture
-def app(tmp_path, scenario_file):
+def app(database_target, scenario_file):
     # imported here so a broken app never stops the db/engine/sim tests from being collected
     from app.config import Settings
     from app.main import create_app
 
-    return create_app(Settings(db_path=tmp_path / "hmi.db", scenario_path=scenario_file))
+    return create_app(Settings(**database_settings(database_target), scenario_path=scenario_file))
 
 
 @pytest.fixture

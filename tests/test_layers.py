@@ -18,6 +18,7 @@ LAYERS = [
     ("db", 0),
     ("app.machine", 1),
     ("app.config", 2), ("app.gud", 2), ("app.records", 2), ("app.errors", 2), ("app.http_limits", 2),
+    ("app.checks", 2),            # the strict number checks of every client input (issue 25)
     ("app.i18n", 2),              # operator languages: catalogues and formats, used by the screens
     ("app.access", 2),            # levels, identity, errors, service, checks: below the services
     ("app.workflow", 3), ("app.nc", 3),

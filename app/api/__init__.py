@@ -14,7 +14,21 @@ from pydantic import BaseModel, Field
 
 from app.access.deps import guard
 
-from . import access, data, events, lathe, machine, measure, nc, plc, programs, results, setup_support
+from . import (
+    access,
+    data,
+    events,
+    lathe,
+    machine,
+    measure,
+    nc,
+    plant,
+    plc,
+    probe_test,
+    programs,
+    results,
+    setup_support,
+)
 
 
 def operation_id(route: APIRoute) -> str:
@@ -44,7 +58,7 @@ ERRORS: dict[int | str, dict[str, Any]] = {"4XX": {"model": ErrorEnvelope, "desc
                                                          "415 non-JSON body, 422 validation"}}
 api_router = APIRouter(prefix="/api", generate_unique_id_function=operation_id, dependencies=[Depends(guard)],
                        responses=ERRORS)
-for module in (machine, data, measure, setup_support, plc, access, nc, programs, lathe, events, results):
+for module in (machine, data, measure, setup_support, plc, access, nc, programs, lathe, events, results, probe_test, plant):
     for route in module.router.routes:
         if isinstance(route, APIRoute) and route.summary is None:
             route.summary = route.endpoint.__name__.replace("_", " ").title()    # FastAPI's default

@@ -32,7 +32,7 @@ async def events(request: Request, machine: MachineDep, workflow: WorkflowDep,
         current = workflow.session
         return None if current is None else current.to_api()
 
-    feed = LiveFeed(machine.status, session)
+    feed = LiveFeed(machine.status, session, machine.changes)
     stream = feed.events(limit, request.is_disconnected)
     if tab is not None:
         machine.tab_back(tab)

@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Annotated, Literal
 
 from fastapi import APIRouter, Body, Query, Request
-from pydantic import BaseModel, ConfigDict, Field, StrictFloat, StrictInt, StrictStr
+from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, StrictInt, StrictStr
 
 from app.access.deps import needs
 from app.deps import MachineDep
@@ -152,6 +152,20 @@ def machine_part(machine: MachineDep, body: Annotated[MachinePartBody | None, Bo
     features made by ``machined_by`` tools are cut with the tools' true size against the tool
     data the control holds now; then the tools wear by ``wear_per_part``."""
     return machine.machine_part((body or MachinePartBody()).scatter_sigma)
+
+
+class SimProbeBody(_Body):
+    probe: Literal["workpiece", "tool"] = "workpiece"
+    deflect: StrictBool | None = Field(None, description="true: deflect the stylus by hand, false: let go")
+    battery: StrictFloat | None = Field(None, ge=0.0, le=1.0, description="a radio probe's charge 0..1")
+    armed: StrictBool | None = Field(None, description="switch a radio probe on (true) or off (false)")
+
+
+@router.post("/sim/probe", name="api_sim_probe", dependencies=[needs("jog")])
+def sim_probe(body: SimProbeBody, machine: MachineDep) -> dict:
+    """The operator's hand on a probe of the simulator (design.md §10.4): deflect or release it,
+    change a radio probe's battery, switch it on or off. Answers the ``GET /api/machine`` body."""
+    return machine.set_probe(body.probe, body.deflect, body.battery, body.armed)
 
 
 @router.post("/sim/scenario", name="api_sim_scenario", dependencies=[needs("scenario")])

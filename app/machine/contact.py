@@ -156,6 +156,24 @@ class Contact:
         centre = self._kinematics.ball_centre(position, spindle_angle)
         return self._scene.sdf(centre) < self._scenario.probe.ball_diameter / 2.0
 
+    def touching(self, position: np.ndarray, tool: int | None, spindle_angle: float) -> tuple[bool, bool]:
+        """(workpiece probe, tool probe): does a solid deflect it at the axes ``position`` now?
+        The ball deflects the workpiece probe against any solid and the tool probe against its
+        disc; a cutter deflects the tool probe (design.md §10.4)."""
+        if tool is None:
+            return False, False
+        tp = self._scenario.tool_probe
+        if self.is_probe(tool):
+            centre = self._kinematics.ball_centre(position, spindle_angle)
+            radius = self._scenario.probe.ball_diameter / 2.0
+            on_tool_probe = tp is not None and self._scene.subset({"tool_probe"}).sdf(centre) < radius
+            return bool(self._scene.sdf(centre) < radius), bool(on_tool_probe)
+        if tp is None:
+            return False, False
+        cutter = self._cutter(tool)
+        grown = tool_probe_cylinder(tp, cutter.radius, cutter.length, self._kinematics.mount)
+        return False, bool(grown.sdf(self._kinematics.cutter_tip(position, cutter)) < 0.0)
+
     def swivel_hits(self, start: np.ndarray, target: np.ndarray, tool: int | None, spindle_angle: float) -> bool:
         """Sample the swivel path (end pose included): does the ball/cutter end touch a solid?"""
         if tool is None:

@@ -48,6 +48,7 @@ from .lathe_scenario import LatheScenario
 from .lathe_scene import LatheContact, lathe_outline, tool_outline
 from .motion import Motion
 from .nc_data import NcData, _number, _object
+from .probe_signal import TOOL, WORKPIECE, ProbeSignals
 from .protocol import (
     ActiveFrame,
     Alarm,
@@ -138,6 +139,8 @@ class LatheMachine:
             self._alarms: list[Alarm] = []
             self._worn: dict[int, tuple[float, float]] = {}
             self._parts = 0
+            self._probes = ProbeSignals(scenario.probe.radio, scenario.tool_probe.radio if scenario.tool_probe
+                                        else None, scenario.tool_probe is not None)
 
     def load(self, scenario: LatheScenario) -> None:
         self.reset()
@@ -198,12 +201,22 @@ class LatheMachine:
             wcs = {"X": float(p[0]), "Y": float(p[1]), "Z": float(p[2])}
             if self.diameter_programming:
                 wcs["X"] *= 2.0
+            on_probe, on_tool_probe = self._contact.touching(position, self._tool, self._spindle_angle,
+                                                             self._worn_of(self._tool))
             return LatheStatus(
                 mcs=self._kinematics.as_dict(position), wcs=wcs, active_offset=self._frame.name, tool=self._tool,
                 tool_length=float(l1), feed_override=self._override, spindle_angle=self._spindle_angle,
                 spindle_speed=self._spindle_speed, busy=self._motion.busy, alarms=tuple(self._alarms),
                 plane="G18", tool_axis=(1.0, 0.0, 0.0), tool_lengths=(float(l1), float(l2)),
-                diameter_programming=self.diameter_programming)
+                diameter_programming=self.diameter_programming,
+                probe=self._probes.state(WORKPIECE, self._contact.is_probe(self._tool), on_probe),
+                tool_probe=self._probes.state(TOOL, True, on_tool_probe) if self._probes.has(TOOL) else None)
+
+    def set_probe(self, which: str, deflect: bool | None = None, battery: float | None = None,
+                  armed: bool | None = None) -> None:
+        """The operator's hand on a probe (design.md §10.4, probe_signal.py)."""
+        with self._lock:
+            self._probes.set(which, deflect, battery, armed)
 
     # --- settings without motion ------------------------------------------------------------
     def change_tool(self, tool: int | None, offset_length: float = 0.0) -> None:

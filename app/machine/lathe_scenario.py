@@ -42,6 +42,8 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
+from .probe_signal import Radio
+
 PRETRAVEL_KEYS = ("X+", "X-", "Y+", "Y-", "Z+", "Z-")
 FACE_KEYS = ("Z-", "Z+", "X-", "X+")          # the _TP order (turning.md §0.7)
 DEFAULT_LIMITS = {"X": (-50.0, 600.0), "Z": (-50.0, 800.0)}
@@ -135,6 +137,7 @@ class LatheProbe(_Model):
     noise_sigma: NonNegative = 0.0
     max_deflection: Positive = 2.0
     nominal: ProbeNominal = Field(default_factory=ProbeNominal)
+    radio: Radio | None = None                    # a radio/optical probe (design.md §10.4); None: cable
 
     @field_validator("pretravel")
     @classmethod
@@ -155,6 +158,7 @@ class ToolProbeCube(_Model):
     max_deflection: Positive = 1.0
     y_size: Positive = 20.0
     nominal: dict[str, Finite] | None = None
+    radio: Radio | None = None                    # a radio tool probe (design.md §10.4); None: cable
 
     @field_validator("faces", "nominal")
     @classmethod

@@ -205,6 +205,26 @@ class LatheContact:
         return scene.subset(set(OBSTACLES)).sdf(self._kinematics.nose_centre(position, cutter, worn)) \
             < cutter.radius - 1e-12
 
+    def touching(self, position: np.ndarray, tool: int | None, angle: float,
+                 worn: tuple[float, float] = (0.0, 0.0)) -> tuple[bool, bool]:
+        """(workpiece probe, tool probe): does a solid deflect it at the axes ``position`` now?
+        The ball deflects the probe against any solid (the tool probe's cube too); the ball or a
+        tool's nose on the cube deflects the tool probe (design.md §10.4)."""
+        if tool is None:
+            return False, False
+        scene = self.scene(angle)
+        cube = scene.subset({"tool_probe"})
+        if self.is_probe(tool):
+            centre = self._kinematics.ball_centre(position)
+            radius = self._scenario.probe.ball_diameter / 2.0
+            on_cube = self._scenario.tool_probe is not None and cube.sdf(centre) < radius - 1e-12
+            return bool(scene.sdf(centre) < radius - 1e-12), bool(on_cube)
+        if self._scenario.tool_probe is None:
+            return False, False
+        cutter = self._cutter(tool)
+        nose = self._kinematics.nose_centre(position, cutter, worn)
+        return False, bool(cube.sdf(nose) < cutter.radius - 1e-12)
+
     # --- after the event ------------------------------------------------------------------------
     def braking(self, feed_in_effect: float) -> float:
         cfg = self._scenario.machine

@@ -62,6 +62,24 @@ class ActiveFrame:
 
 
 @dataclass(frozen=True)
+class ProbeState:
+    """What a probe tells the control besides its switch (design.md §10.4).
+
+    ``in_spindle``: the workpiece probe is the tool in the spindle (the tool probe: it is there);
+    ``armed``/``battery``: a radio or optical probe is switched on / its charge 0..1 (None: a
+    cable probe, always ready); ``deflected``: the probe signal is on now (None: not known)."""
+
+    in_spindle: bool
+    armed: bool | None = None
+    deflected: bool | None = False
+    battery: float | None = None
+
+    def to_api(self) -> dict:
+        return {"in_spindle": self.in_spindle, "armed": self.armed, "deflected": self.deflected,
+                "battery": self.battery}
+
+
+@dataclass(frozen=True)
 class MachineStatus:
     mcs: dict[str, float]            # tool reference point, X/Y/Z (+ rotary axes)
     wcs: dict[str, float]            # tool tip (probe ball centre) in the active WCS
@@ -77,6 +95,8 @@ class MachineStatus:
     plane: str = "G17"
     tool_axis: tuple[float, float, float] = (0.0, 0.0, 1.0)   # MCS unit vector tip -> spindle (swivel head,
     #                                                           horizontal spindle: scenario machine.spindle_axis)
+    probe: ProbeState | None = None          # the workpiece probe; None: the controller cannot tell
+    tool_probe: ProbeState | None = None     # the tool probe; None: none, or the controller cannot tell
 
 
 @dataclass(frozen=True)
@@ -212,6 +232,12 @@ class SimulatorControl(Protocol):
 
     def machine_part(self, scatter_sigma: float = 0.0) -> int:
         """The next part of a machined-part series replaces the workpiece (design.md §9.3)."""
+
+    def set_probe(self, which: str, deflect: bool | None = None, battery: float | None = None,
+                  armed: bool | None = None) -> None:
+        """The operator's hand on probe ``which`` ("workpiece", "tool"): deflect or release it,
+        change the battery, switch a radio probe on or off (design.md §10.4). ValueError names
+        the field."""
 
 
 def add_alarm_once(alarms_shown: list[Alarm], alarm: Alarm) -> Alarm:

@@ -14,6 +14,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from .lathe_scenario import LatheScenario
 from .polygon import check_simple_polygon, polygon_area
+from .probe_signal import Radio
 
 DEMO_SCENARIO_PATH = Path(__file__).with_name("demo_scenario.json")
 LATHE_DEMO_SCENARIO_PATH = Path(__file__).with_name("lathe_demo_scenario.json")
@@ -145,6 +146,7 @@ class ProbeConfig(_Model):
     lobing: list[LobeHarmonic] = Field(default_factory=list, max_length=12)   # on top of ``pretravel``
     noise_sigma: NonNegative = 0.0
     max_deflection: Positive = 2.0
+    radio: Radio | None = None                    # a radio/optical probe (design.md §10.4); None: cable
 
     @field_validator("pretravel")
     @classmethod
@@ -314,6 +316,7 @@ class ToolProbe(_Model):
     disc_diameter: Positive
     height: Positive = 40.0
     pretravel: NonNegative = 0.0
+    radio: Radio | None = None                    # a radio tool probe (design.md §10.4); None: cable
 
 
 class ToolNominal(_Model):

@@ -47,6 +47,7 @@ from .contact import Contact, Event
 from .kinematics import XYZ, Kinematics
 from .motion import Motion
 from .nc_data import NcData
+from .probe_signal import TOOL, WORKPIECE, ProbeSignals
 from .protocol import (
     ActiveFrame,
     Alarm,
@@ -93,6 +94,8 @@ class SimulatedMachine:
             self._spindle_angle = 0.0
             self._spindle_speed = 0.0
             self._alarms: list[Alarm] = []
+            self._probes = ProbeSignals(scenario.probe.radio, scenario.tool_probe.radio if scenario.tool_probe
+                                        else None, scenario.tool_probe is not None)
 
     def load(self, scenario: Scenario) -> None:
         """Replace the truth and reset the machine (axes to the start position, probe in spindle)."""
@@ -171,12 +174,21 @@ class SimulatedMachine:
             wcs = {a: float(p_in_wcs[i]) for i, a in enumerate(GEOMETRY_AXES)}
             for a in self.axes[3:]:
                 wcs[a] = mcs[a] - float(self._frame.rotary_offsets.get(a, 0.0))
+            on_probe, on_tool_probe = self._contact.touching(position, self._tool, self._spindle_angle)
             return MachineStatus(
                 mcs=mcs, wcs=wcs, active_offset=self._frame.name, tool=self._tool,
                 tool_length=float(tool_length), feed_override=self._override,
                 spindle_angle=self._spindle_angle, spindle_speed=self._spindle_speed,
                 busy=self._motion.busy, alarms=tuple(self._alarms),
-                tool_axis=(float(axis[0]), float(axis[1]), float(axis[2])))
+                tool_axis=(float(axis[0]), float(axis[1]), float(axis[2])),
+                probe=self._probes.state(WORKPIECE, self._contact.is_probe(self._tool), on_probe),
+                tool_probe=self._probes.state(TOOL, True, on_tool_probe) if self._probes.has(TOOL) else None)
+
+    def set_probe(self, which: str, deflect: bool | None = None, battery: float | None = None,
+                  armed: bool | None = None) -> None:
+        """The operator's hand on a probe (design.md §10.4, probe_signal.py)."""
+        with self._lock:
+            self._probes.set(which, deflect, battery, armed)
 
     # --- settings without motion ---------------------------------------------------------
     def change_tool(self, tool: int | None, offset_length: float) -> None:

@@ -80,6 +80,18 @@ FUNCTIONS: dict[str, tuple[int, Callable[..., float]]] = {
 }
 
 
+def as_text(value: Value) -> str:
+    """A value as ``<<`` converts it: texts stay, whole numbers without decimals, reals in their
+    shortest form (3.5, 0.001)."""
+    if isinstance(value, str):
+        return value
+    if isinstance(value, bool):
+        return "1" if value else "0"
+    if isinstance(value, float) and value.is_integer():
+        return str(int(value))
+    return repr(value) if isinstance(value, float) else str(value)
+
+
 def _num(value: Value, pos: n.Pos, what: str) -> float:
     if isinstance(value, str):
         raise EvalError(f"{what}: the text \"{value}\" is not a number", pos, alarms.NC_VALUE_RANGE)
@@ -119,6 +131,8 @@ class Evaluator:
             return self.read(e)
         if isinstance(e, n.Unary):
             v = self._eval(e.operand)
+            if e.op == "<<":
+                return as_text(v)
             if e.op == "NOT":
                 return not _num(v, e.pos, "NOT")
             x = _num(v, e.pos, e.op)
@@ -132,6 +146,8 @@ class Evaluator:
     def _binary(self, e: n.Binary) -> Value:
         a, b = self._eval(e.left), self._eval(e.right)
         op = e.op
+        if op == "<<":
+            return as_text(a) + as_text(b)
         if op in ("==", "<>") and (isinstance(a, str) or isinstance(b, str)):
             if not (isinstance(a, str) and isinstance(b, str)):
                 raise EvalError(f"'{op}' compares a text with a number", e.pos, alarms.NC_VALUE_RANGE)

@@ -156,6 +156,16 @@ class CycleContext:
     runtime: NcRuntime
     _interpreter: Interpreter = field(repr=False)
     _pos: n.Pos = field(repr=False)
+    # (name, index) of each argument written as a plain variable, else None: the 840D's
+    # call-by-reference parameters (CYCLE118 returns its text in its third argument)
+    arg_refs: tuple[tuple[str, tuple] | None, ...] = ()
+
+    def set_argument(self, number: int, value) -> None:
+        """Write ``value`` into the variable given as argument ``number`` (0-based)."""
+        ref = self.arg_refs[number] if number < len(self.arg_refs) else None
+        if ref is None:
+            raise self.alarm(alarms.NC_SYNTAX, f"{self.name}: argument {number + 1} must be a variable")
+        self.variables.set(ref[0], value, ref[1])
 
     @property
     def plane_axes(self) -> tuple[str, str, str]:
@@ -348,6 +358,10 @@ class Interpreter:
     def request_stop(self) -> None:
         """NC Stop (thread-safe): the running program stops before its next block; run() resumes."""
         self._stop.set()
+
+    def cancel_stop(self) -> None:
+        """NC Start after an NC Stop that the program has not reached yet: it goes on."""
+        self._stop.clear()
 
     def run(self) -> RunResult:
         """Run to the end, M0, a stop request or an alarm."""
@@ -741,8 +755,11 @@ class Interpreter:
         handler = self.cycles.get(word.name)
         if handler is None:
             raise self._alarm(word, alarms.NC_NAME_UNKNOWN, f"{word.name} is not a cycle of this control")
+        ev = Evaluator(self.variables)
+        refs = tuple((a.name, ev.index(a, self.variables.definition(a.name))) if isinstance(a, n.Var) else None
+                     for a in word.args)
         ctx = CycleContext(word.name, args, BlockRef.of(block), self.variables, self._modal, self.runtime,
-                           self, word.pos)
+                           self, word.pos, refs)
         try:
             handler(ctx)
         except NcAlarm as e:

@@ -38,7 +38,7 @@ _TERMINAL_WORDS = {
     "BLOCKNO": "a block number", "CMP_OP": "a comparison", "ADD_OP": "'+' or '-'",
     "MUL_OP": "'*' or '/'",
 }
-_EXPRESSION_START = {"NUMBER", "INT_NUMBER", "NAME", "RPARAM", "STRING", "LPAR", "ADD_OP", "NOT",
+_EXPRESSION_START = {"NUMBER", "INT_NUMBER", "NAME", "RPARAM", "STRING", "LPAR", "ADD_OP", "NOT", "CONCAT",
                      "TRUE", "FALSE"}
 _UNSUPPORTED_ADDRESS = {
     "I": "circle and helix parameters (I, J, K) are not part of this control's language",
@@ -233,8 +233,10 @@ class _ToNodes(Transformer):
         return ("LABEL", tok)
 
 
-#: how strongly an operator binds (840D: comparisons weakest, then OR, XOR, AND, + -, * / DIV MOD)
-_PRIORITY = {"CMP_OP": 1, "OR": 2, "XOR": 3, "AND": 4, "ADD_OP": 5, "MUL_OP": 6, "DIV": 6, "MOD": 6}
+#: how strongly an operator binds (840D: comparisons weakest, then << (text concatenation), OR,
+#: XOR, AND, + -, * / DIV MOD)
+_PRIORITY = {"CMP_OP": 1, "CONCAT": 1.5, "OR": 2, "XOR": 3, "AND": 4, "ADD_OP": 5, "MUL_OP": 6, "DIV": 6,
+             "MOD": 6}
 
 
 def _climb(items: list) -> n.Expr:

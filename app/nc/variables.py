@@ -183,7 +183,10 @@ class VarDef:
             return value
         if isinstance(value, str):
             raise InvalidValue(f"{self.name} holds a number, not the text \"{value}\"")
-        number = float(value)
+        try:
+            number = float(value)
+        except OverflowError:           # an integer beyond the REAL range (issue 25)
+            raise InvalidValue(f"{self.name}: the value is too large for a REAL") from None
         if not math.isfinite(number):
             raise InvalidValue(f"{self.name}: the value is not a finite number")
         if self.type == "REAL":
@@ -490,6 +493,7 @@ def system_variables() -> list[VarDef]:
         sys("$AA_IW", "actual position, workpiece coordinates", axis_indexed=True),
         sys("$P_TOOLNO", "tool in the spindle (0 = none)", type="INT"),
         sys("$P_TOOL", "active D number", type="INT"),
+        sys("$PI", "the circle constant pi", default=math.pi),
     ]
 
 

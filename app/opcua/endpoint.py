@@ -25,6 +25,7 @@ from app.services import Services
 
 from . import security
 from .alarms import AlarmEvents
+from .results import ResultManagement
 from .space import JogMeasureSpace
 from .users import HmiUserManager
 from .values import alarm_keys, machine_values, measurement_value, offset_values
@@ -138,6 +139,8 @@ class OpcUaEndpoint:
         updates.alarms = AlarmEvents()
         await updates.alarms.setup(server, idx, space.node(("Machine",)))
         await updates.step()                       # the alarms of the start are the baseline
+        updates.results = ResultManagement(server, idx, self._services)      # OPC 40001-101 (design.md §10.3)
+        await updates.results.setup(space.node(()))
         iserver = server.iserver
         iserver.attribute_service = GuardedAttributeService(
             iserver.aspace, self._services, self._access, space.writable, updates.show_offset)
@@ -171,6 +174,7 @@ class Updates:
         self.alarms: AlarmEvents | None = None
         self._generation: int | None = None
         self.umati: MachineToolInstance | None = None
+        self.results: ResultManagement | None = None
 
     def _read(self) -> tuple[dict, dict | None, list | None]:
         status = self._services.machine.status()
@@ -190,6 +194,8 @@ class Updates:
             stored = offset_values(offsets, self._services.machine.rotary_axes)
             await self._space.prune(stored, (("ZeroOffsets",),))
             values |= stored | measurement_value(newest[0] if newest else None)
+            if self.results is not None:
+                await self.results.notify(newest[0] if newest else None)
         await self._space.show(values)
         if self.alarms is not None:
             await self.alarms.show(alarm_keys(status))

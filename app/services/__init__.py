@@ -16,8 +16,11 @@ from .machine_service import MachineService
 from .memories import MemoryService
 from .nc import NcService, ProgramService
 from .offsets import OffsetService
+from .plant import PlantService
 from .plc import PlcSimulator
+from .probe_test import ProbeTestService
 from .probes import ProbeService, ToolProbeService
+from .quality import QualityService
 from .results import ResultsService
 from .settings import SettingsService
 from .tools import ToolService
@@ -38,8 +41,11 @@ class Services:
     plc: PlcSimulator | None = None
     nc: NcService | None = None
     programs: ProgramService | None = None
+    probe_test: ProbeTestService | None = None
     results: ResultsService | None = None
+    quality: QualityService | None = None
+    plant: PlantService | None = None
 
 
-__all__ = ["LogService", "MachineService", "MemoryService", "NcService", "OffsetService", "ProbeService", "ProgramService", "ResultsService",
+__all__ = ["LogService", "MachineService", "MemoryService", "NcService", "OffsetService", "ProbeService", "ProgramService", "QualityService", "ResultsService",
            "Services", "ToolProbeService", "SettingsService", "ToolService"]

@@ -15,9 +15,9 @@ values an operator enters (``params.groove``: SL 7 ``x_minus``, ``x_plus``, ``bo
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 
+from app import checks
 from app.errors import InvalidInput, NotFoundError
 from db import Database
 
@@ -88,9 +88,7 @@ def check_groove(values) -> dict:
             continue
         if key not in GROOVE_KEYS:
             raise InvalidInput(f"{key}: not a groove value ({', '.join(GROOVE_KEYS)})", field=key)
-        if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-            raise InvalidInput(f"{key}: must be a finite number", field=key)
-        out[key] = float(value)
+        out[key] = checks.number(value, key)
     return out
 
 
@@ -106,9 +104,7 @@ class GrooveService:
         return [{"number": i + 1, **record} for i, record in enumerate(records)]
 
     def _number(self, n) -> int:
-        if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= GROOVE_RECORDS:
-            raise InvalidInput(f"n: groove record 1..{GROOVE_RECORDS} (_CVAL[2])", field="n")
-        return n
+        return checks.integer(n, "n", lo=1, hi=GROOVE_RECORDS)
 
     def get(self, n: int) -> dict:
         n = self._number(n)

@@ -23,7 +23,6 @@ With a swivel head turned out of +Z the length goes along the machine's actual t
 
 from __future__ import annotations
 
-import math
 import threading
 import time
 from collections.abc import Callable, Mapping
@@ -33,6 +32,7 @@ from typing import overload
 
 import numpy as np
 
+from app import checks
 from app.errors import AlarmError, BusyError, ConflictError, InvalidInput, NotFoundError
 from app.machine.lathe_scenario import LatheScenario
 from app.machine.protocol import (
@@ -41,7 +41,9 @@ from app.machine.protocol import (
     Machine,
     MachineAlarm,
     MachineBusy,
+    MachineStatus,
     MoveResult,
+    ProbeState,
     SimulatorControl,
     SwivelHead,
 )
@@ -55,6 +57,7 @@ from engine.frames import G500, Frame, FrameChain, chain_of, is_basic
 from engine.planes import plane as plane_by_name
 
 from . import lathe_data
+from .live import ChangeSignal
 from .settings import SettingsService
 
 CHANNEL = "CHAN1"
@@ -65,9 +68,7 @@ STATE_TOOL = "tool"
 
 
 def _finite(value, field: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise InvalidInput(f"{field}: must be a finite number", field=field)
-    return float(value)
+    return checks.number(value, field)
 
 
 def alarm_dict(alarm: Alarm) -> dict:
@@ -96,7 +97,14 @@ class MachineService:
         self._hold = HoldToRun(machine)
         self._frames: tuple[int, dict[str, Frame]] | None = None
         self._discard_listeners: list[Callable[[str], None]] = []
+        # one channel (issue 24 §3-4): what a Reset ends, what the mode group refuses, NC Stop's hold
+        self._reset_listeners: list[tuple[Callable[[], None], Callable[[], None]]] = []
+        self._interlocks: list[Callable[[str], None]] = []
+        self._held_override: float | None = None
         self.mode_source: Callable[[], str | None] | None = None   # the NC channel's mode (MDA/AUTO)
+        # what runs and locks the rest ({"mode", "program"}: a program, a JOG measurement) or None
+        self.lock_source: Callable[[], dict | None] | None = None
+        self.changes = ChangeSignal()        # a change without motion (a probe deflected by hand): the live feed
         with db.unit(readonly=True) as unit:
             active = unit.get_state(STATE_ACTIVE_OFFSET, G500)
             tool = unit.get_state(STATE_TOOL, None)
@@ -160,12 +168,41 @@ class MachineService:
             "spindle_angle": float(st.spindle_angle),
             "alarms": alarms,
             "busy": bool(st.busy),
+            "feed_hold": self._held_override is not None,
+            "lock": self.lock_source() if self.lock_source else None,
             "program_state": program_state,
             "tool_axis": [float(v) for v in getattr(st, "tool_axis", (0.0, 0.0, 1.0))],
             "swivel": self.has_swivel(),
             "controller": self._machine.controller,
+            **self._probe_status(st),
             **(self._lathe_status(st) if self.is_lathe else {}),
         }
+
+    def probe_status(self) -> dict:
+        """``{"probe", "tool_probe"}`` of ``status()``, read alone (the probe test samples it)."""
+        return self._probe_status(self._machine.status())
+
+    def _probe_status(self, st: MachineStatus) -> dict:
+        """``probe`` and ``tool_probe`` (design.md §10.4); a controller that cannot tell its
+        probe's state shows only whether the probe is the tool in the spindle."""
+        probe = st.probe or ProbeState(in_spindle=st.tool is not None and st.tool == self._scenario.probe.t,
+                                       deflected=None)
+        tool_probe = None
+        if st.tool_probe is not None:
+            tool_probe = {k: v for k, v in st.tool_probe.to_api().items() if k != "in_spindle"}
+        return {"probe": probe.to_api(), "tool_probe": tool_probe}
+
+    def set_probe(self, which: str, deflect=None, battery=None, armed=None) -> dict:
+        """The operator's hand on a probe of the simulator (``POST /api/sim/probe``, design.md §10.4)."""
+        simulator = self._simulator("a hand on the probe")
+        try:
+            simulator.set_probe(which, deflect, battery, armed)
+        except ValueError as exc:
+            field = str(exc).partition(":")[0]
+            raise InvalidInput(str(exc), field=field if field in ("probe", "deflect", "battery", "armed")
+                               else None) from None
+        self.changes.notify()
+        return self.status()
 
     def _lathe_status(self, st) -> dict:
         l1, l2 = getattr(st, "tool_lengths", (0.0, 0.0))
@@ -271,6 +308,7 @@ class MachineService:
             raise AlarmError(exc.alarm.code, exc.alarm.text) from None
 
     def _run(self, motion: Callable[[], MoveResult]) -> dict:
+        self.interlock("jog")
         self._ensure_idle()
         with self._machine_errors():
             result = motion()
@@ -296,6 +334,7 @@ class MachineService:
             raise InvalidInput("direction: must be -1 or +1", field="direction")
         feed = self._check_feed(feed)
         if not self._hold.renew(axis, direction, tab, press) and not self._hold.stale(tab, press):
+            self.interlock("jog")
             self._ensure_idle()
             with self._machine_errors():
                 self._hold.start(axis, direction, feed, tab, press)
@@ -368,6 +407,7 @@ class MachineService:
         if not 0 < distance <= MAX_TRAVEL:
             raise InvalidInput(f"distance: must be > 0 and <= {MAX_TRAVEL:g}", field="distance")
         feed = self._check_feed(_finite(feed, "feed"))
+        self.interlock("probe")
         self._ensure_idle()
         with self._machine_errors():
             result = self._machine.probe(d, distance, feed)
@@ -381,15 +421,56 @@ class MachineService:
             "override": float(result.override),
         }
 
+    # --- one channel: Reset, the mode group, feed hold (issue 24 §3-4) ---------------------------
+    def on_reset(self, stop: Callable[[], None], wait: Callable[[], None]) -> None:
+        """A runner of motion (the NC channel, a JOG measurement) ends at a Reset: ``stop()`` tells
+        it (no new motion), ``wait()`` returns when it has ended."""
+        self._reset_listeners.append((stop, wait))
+
+    def add_interlock(self, check: Callable[[str], None]) -> None:
+        """``check(action)`` raises ``ModeError`` when ``action`` ("jog", "probe", "spindle",
+        "tool_change", "scenario", "measure", "nc_run") is refused while something runs."""
+        self._interlocks.append(check)
+
+    def interlock(self, action: str) -> None:
+        for check in self._interlocks:
+            check(action)
+
     def reset(self) -> dict:
+        """The channel's one Reset (panel key, ``/api/machine/reset``, ``/api/nc/reset``): the
+        runners are told to stop, the motion stops, the runners end (program reset to its
+        defaults, measurement aborted), feed hold ends, the resettable alarms are cleared."""
+        self._hold.release()
+        for stop, _wait in self._reset_listeners:
+            stop()
         self._machine.reset()
+        for _stop, wait in self._reset_listeners:
+            wait()
+        self.feed_hold(False)
+        self._machine.reset()                   # a motion begun meanwhile, the alarms of the abort
         return self.status()
+
+    def feed_hold(self, on: bool) -> None:
+        """NC Stop holds the axes where they are (override 0 %); NC Start lets them go on at the
+        override they had."""
+        with self._lock:
+            if on and self._held_override is None:
+                self._held_override = float(self._machine.status().feed_override)
+                self._machine.set_override(0.0)
+            elif not on and self._held_override is not None:
+                self._machine.set_override(self._held_override)
+                self._held_override = None
+
+    @property
+    def feed_held(self) -> bool:
+        return self._held_override is not None
 
     def spindle_position(self, angle: float) -> dict:
         """SPOS (deg, 0..360): on a lathe the clamped workpiece turns with the main spindle."""
         angle = _finite(angle, "angle")
         if not 0.0 <= angle <= 360.0:
             raise InvalidInput("angle: SPOS 0..360 degrees", field="angle")
+        self.interlock("spindle")
         self._ensure_idle()
         with self._machine_errors():
             self._machine.spindle_position(angle)
@@ -399,7 +480,11 @@ class MachineService:
         percent = _finite(percent, "feed")
         if not 0 <= percent <= 120:
             raise InvalidInput("feed: override must be 0..120 %", field="feed")
-        self._machine.set_override(percent)
+        with self._lock:
+            if self._held_override is not None:       # held: the new override acts at NC Start
+                self._held_override = float(percent)
+            else:
+                self._machine.set_override(percent)
         return self.status()
 
     # --- tools ------------------------------------------------------------------------------
@@ -443,6 +528,7 @@ class MachineService:
             if data is None:
                 raise NotFoundError(f"T{t} is not in the tool table", field="tool", code="unknown_tool")
             length = self.offset_length(data)
+        self.interlock("tool_change")
         self._ensure_idle()
         with self._db.unit() as unit:
             unit.set_state(STATE_TOOL, t)
@@ -531,6 +617,7 @@ class MachineService:
     def load_scenario(self, scenario: Scenario | LatheScenario, reset_data: bool = False) -> dict:
         """Reset the machine to ``scenario``; stored data stays unless ``reset_data``."""
         simulator = self._simulator("a scenario load")
+        self.interlock("scenario")
         self._ensure_idle()
         self._hold.release()
         with self._lock:

@@ -35,6 +35,8 @@ def probe_record_from(data: dict | None, tool: dict | None, length_to_tip: bool)
     data = data or {}
     skew = data.get("skew") or (0.0, 0.0)          # (x, y): a stored record is checked (app.records)
     ball = 2.0 * float(tool["radius"]) if tool and tool.get("radius") else float(data.get("ball_diameter", 4.0))
+    if data.get("calibrated_radius") and data.get("measured_ball_diameter"):
+        ball = float(data["measured_ball_diameter"])     # the ring chords measured it (engine.calibration)
     return ProbeRecord(
         number=int(data.get("number", 1)),
         ball_diameter=ball,
@@ -82,6 +84,9 @@ class MeasuringEnv:
     @property
     def machine(self) -> Machine:
         return self._ms.machine
+
+    def interlock(self, action: str) -> None:
+        self._ms.interlock(action)
 
     def release_jog(self) -> None:
         """NC Start begins a measurement: forget a held jog, so that its dead-man watchdog cannot

@@ -6,14 +6,21 @@ manual's default 20 each). Reads give 0 for a memory never written; every write 
 
 from __future__ import annotations
 
-import math
-
+from app import checks
 from app.errors import InvalidInput
 from db import Database
 
 MEMORY_COUNT = 20
 KINDS = {"ev": "EV", "mv": "MV"}
 MAX_VALUE = 1000.0          # mm: a memory beyond is a typo
+#: the access function a memory write needs on every route (API, screen, NC program, NC variables;
+#: the level table: "offsets ... EV/MV memories")
+WRITE_FUNCTION = "offsets"
+
+
+def check_value(value, field: str = "value") -> float:
+    """A memory's value: the same range through the API, the screen and an NC program (_EV[i]=)."""
+    return checks.number(value, field, lo=-MAX_VALUE, hi=MAX_VALUE, unit="mm")
 
 
 class MemoryService:
@@ -24,9 +31,7 @@ class MemoryService:
     def _key(kind: str, n) -> tuple[str, int]:
         if kind not in KINDS:
             raise InvalidInput("kind: must be ev or mv", field="kind")
-        if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MEMORY_COUNT:
-            raise InvalidInput(f"n: memory number 1..{MEMORY_COUNT}", field="n")
-        return KINDS[kind], n
+        return KINDS[kind], checks.integer(n, "n", lo=1, hi=MEMORY_COUNT)
 
     def get(self, kind: str, n: int) -> dict:
         name, n = self._key(kind, n)
@@ -41,9 +46,7 @@ class MemoryService:
 
     def put(self, kind: str, n: int, value, source: str = "api") -> dict:
         name, n = self._key(kind, n)
-        if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value) \
-                or abs(value) > MAX_VALUE:
-            raise InvalidInput(f"value: a finite number within ±{MAX_VALUE:g} mm", field="value")
+        number = check_value(value)
         with self._db.unit() as unit:
-            unit.put_memory(name, n, float(value), source=source)
-        return {"kind": kind, "n": n, "value": float(value)}
+            unit.put_memory(name, n, number, source=source)
+        return {"kind": kind, "n": n, "value": number}

@@ -28,16 +28,21 @@ from typing import Any
 
 import numpy as np
 
-from app.errors import ConflictError, HmiError, InvalidInput, NotFoundError, TooLarge
+from app import checks
+from app.errors import ConflictError, HmiError, InvalidInput, ModeError, NotFoundError, TooLarge
 from app.machine.protocol import MachineAlarm, MachineBusy
 from app.nc import Interpreter, NcRuntimeError, NcStateError, NcSyntaxError, VariableError, Variables
 from app.nc.cycles import measuring_cycles
 from app.nc.interpreter import CycleContext
+from app.nc.nodes import Assign
 from app.nc.parser import MAX_PROGRAM_BYTES
 from app.nc.runtime import MeasureResult
+from app.nc.variables import InvalidValue
 from app.services.machine_service import MachineService
 from app.services.measuring import MeasuringEnv
-from app.services.memories import MEMORY_COUNT
+from app.services.memories import MEMORY_COUNT, WRITE_FUNCTION
+from app.services.memories import check_value as check_memory_value
+from app.services.protocols import ProtocolFileStore
 from app.services.settings import SettingsService
 from app.workflow.service import WorkflowService
 from db import Database
@@ -49,6 +54,27 @@ log = logging.getLogger(__name__)
 
 XYZ = ("X", "Y", "Z")
 MDA = "MDA"
+#: NC variables that are the HMI's stored data -> the access function their write needs on every
+#: route (JSON API, screen, MDA, AUTO): one write path (issue 24 §7); the value checks and the
+#: audit row are the data's own (``_memory_backing``: the memories' range, ``put_memory``'s audit)
+PROTECTED = {"_EV": WRITE_FUNCTION, "_MV": WRITE_FUNCTION}
+
+
+def protected_function(reference: str) -> str | None:
+    """The access function a write of ``reference`` (``_EV[9]``, ``r1``) needs, or None."""
+    return PROTECTED.get(reference.split("[", 1)[0].strip().upper())
+
+
+class WriteRefused(VariableError):
+    """A program assigns stored data its starter may not write: 17070, nothing written."""
+
+    alarm = alarms.NC_WRITE_PROTECTED
+
+
+#: how long a Reset waits for the program thread after its motion was aborted
+RESET_WAIT_S = 2.0
+#: what the mode group refuses from outside a running program (MachineService.interlock actions)
+LOCKED_BY_A_PROGRAM = ("jog", "probe", "spindle", "tool_change", "scenario", "measure")
 PROGRAM_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,31}$")
 
 
@@ -215,12 +241,16 @@ class NcMeasuringEnv:
     def post_alarm(self, code: int, text: str) -> None:
         self._base.post_alarm(code, text)
 
+    def interlock(self, action: str) -> None:
+        self._base.interlock(action)        # the channel's own thread passes (NcService.interlock)
+
 
 class _CycleMeasuring:
     """``app.nc.cycles.NcMeasuring`` over an ``NcMeasuringEnv``."""
 
-    def __init__(self, env: NcMeasuringEnv):
+    def __init__(self, env: NcMeasuringEnv, on_workflow=None):
         self._env = env
+        self._on_workflow = on_workflow
 
     def setup(self):
         return self._env.measuring_setup()
@@ -229,7 +259,10 @@ class _CycleMeasuring:
         return self._env.measuring_context()
 
     def workflow(self, tasks):
-        return WorkflowService(self._env, tasks)
+        workflow = WorkflowService(self._env, tasks)
+        if self._on_workflow is not None:
+            self._on_workflow(workflow)         # a Reset aborts the cycle's measurement too
+        return workflow
 
 
 def _json_ready(value):
@@ -272,7 +305,8 @@ class NcService:
         self._settings = settings
         self.runtime = MachineRuntime(machine_service, db)
         self.variables = Variables(axes=machine_service.axes, backings={
-            "_EV": _memory_backing(db, "EV"), "_MV": _memory_backing(db, "MV")})
+            "_EV": _memory_backing(db, "EV", self._may_write), "_MV": _memory_backing(db, "MV", self._may_write)})
+        self.protocol_files = ProtocolFileStore(db)     # CYCLE100..CYCLE106 write here (design.md §10.3)
         self.cycles = measuring_cycles(self)
         self.interpreter = Interpreter(self.runtime, self.variables, self.cycles)
         self._lock = threading.RLock()
@@ -283,6 +317,9 @@ class NcService:
         self.single_block = False
         self._crash: str | None = None
         self._authorize = None                    # the access check of who started the run
+        self._cycle_workflow: WorkflowService | None = None   # the measurement of the cycle running
+        machine_service.on_reset(self._reset_stop, self._reset_wait)
+        machine_service.add_interlock(self.interlock)
 
     # --- cycle host ------------------------------------------------------------------------------
     def authorize(self, category, target) -> None:
@@ -291,12 +328,37 @@ class NcService:
         if self._authorize is not None:
             self._authorize(category, target)
 
+    def _may_write(self, name: str) -> None:
+        """Before a program's write of stored data lands: the starter's level (17070 else)."""
+        function = PROTECTED.get(name)
+        if function is None or self._authorize is None or threading.current_thread() is not self._thread:
+            return
+        try:
+            self._authorize(None, None, function=function)
+        except HmiError as exc:
+            raise WriteRefused(f"{name}: {exc.message}") from None
+
+    def _check_writes(self, authorize) -> None:
+        """Before NC Start: every assignment of the program to stored data must be allowed to
+        who starts it (403 ``access_level``, nothing moved), as the JSON API refuses it."""
+        program = self.interpreter.program
+        if authorize is None or program is None:
+            return
+        names = {w.target.name for b in program.blocks for w in b.words
+                 if isinstance(w, Assign) and w.target.name in PROTECTED}
+        for name in sorted(names):
+            authorize(None, None, function=PROTECTED[name])
+
     def measuring(self, ctx: CycleContext, settings: Mapping[str, Any], cycle: Mapping[str, Any]):
         block = ctx.block
         text = block.text.strip()
         log_extra = {"program": self._source or MDA, "block": (f"L{block.line}: {text}")[:200],
                      "cycle": _json_ready({**cycle, "block": block.number, "line": block.line})}
-        return _CycleMeasuring(NcMeasuringEnv(self._env, ctx.modal.plane, settings, log_extra))
+        return _CycleMeasuring(NcMeasuringEnv(self._env, ctx.modal.plane, settings, log_extra),
+                               on_workflow=self._set_cycle_workflow)
+
+    def _set_cycle_workflow(self, workflow: WorkflowService) -> None:
+        self._cycle_workflow = workflow
 
     # --- state -------------------------------------------------------------------------------------
     @property
@@ -328,9 +390,12 @@ class NcService:
         if self._crash and alarm is None and st["state"] == "alarm":
             alarm = {"code": alarms.NC_INTERNAL.number, "message": self._crash}
         state = "running" if self.running else ("idle" if self._source is None else st["state"])
+        reason = last.reason if last else None
+        if self.running and self._ms.feed_held:
+            state, reason = "stopped", "feed_hold"          # NC Stop: held in the block, NC Start goes on
         return {"mode": self.mode, "program": self._source, "block": st["block"] if self._source else None,
                 "state": state, "alarm": alarm,
-                "reason": last.reason if last else None, "single_block": self.single_block,
+                "reason": reason, "single_block": self.single_block,
                 "message": st["message"], "modal": st["modal"]}
 
     def result(self) -> dict:
@@ -383,13 +448,16 @@ class NcService:
         """Load the MDA text or a stored program and start it from its first block."""
         if (program is None) == (mda is None):
             raise InvalidInput("give either program (a stored program's name) or mda (the text)", field="program")
+        if mda is not None:
+            check_size(mda, "mda")
+        self._ms.interlock("nc_run")
         with self._lock:
             if program is not None:
                 self._load(self._program_text(program), program, "program")
             elif mda is not None:                 # always here: exactly one of them was given
-                check_size(mda, "mda")
                 self.mda_text = mda
                 self._load(mda, MDA, "mda")
+            self._check_writes(authorize)
             if single_block is not None:
                 self.single_block = bool(single_block)
             self._launch(authorize)
@@ -399,8 +467,14 @@ class NcService:
         """NC Start: continue the loaded program (after M0, single block, NC Stop), or run it
         again from the start when it has ended."""
         with self._lock:
+            if self.running and self._ms.feed_held:        # held by NC Stop: the axes go on
+                self.interpreter.cancel_stop()
+                self._ms.feed_hold(False)
+                return self._answer(wait)
             if self.running:
                 raise ConflictError("the program is already running", code="busy")
+            self._ms.interlock("nc_run")
+            self._ms.feed_hold(False)
             state = self.interpreter.state
             if state == "idle" or self._source is None:
                 raise ConflictError("no program loaded: run an MDA text or select a program", code="no_program")
@@ -408,6 +482,7 @@ class NcService:
                 raise ConflictError("the channel has an alarm: press Reset first", code="alarm")
             if state == "done":
                 self.interpreter.load(self._text, self._source)
+            self._check_writes(authorize)
             if single_block is not None:
                 self.single_block = bool(single_block)
             self._launch(authorize)
@@ -426,6 +501,8 @@ class NcService:
             except Exception as exc:           # an interpreter bug: the channel shows it
                 log.exception("NC channel crashed")
                 self._crash = f"internal error: {exc}"
+            finally:
+                self._ms.feed_hold(False)        # stopped at a block's end: JOG moves at its override again
 
         self._authorize = authorize
         context = contextvars.copy_context()        # who pressed NC Start acts in the thread too (audit)
@@ -447,26 +524,56 @@ class NcService:
         return self.result()
 
     def stop(self) -> dict:
-        """NC Stop: the program stops at the end of the block (a cycle between its points)."""
+        """NC Stop (feed hold): the axes stand where they are and the program stops at the end of
+        its block; NC Start lets the axes go on and the program continue."""
+        if self.running:
+            self._ms.feed_hold(True)
         self.interpreter.request_stop()
         return self.status()
 
     def reset(self) -> dict:
-        """NC Reset: abort the program (and its motion), modal state to the defaults, measuring
-        offsets cleared, the machine's alarms cleared, the program deselected; mode JOG."""
-        with self._lock:
-            if self.running:
-                self.interpreter.request_stop()
-                self._ms.machine.reset()
-                thread = self._thread
-                if thread is not None:
-                    thread.join(30.0)
-            if self.running:
-                raise ConflictError("the program does not stop: try again", code="busy")
-            self.interpreter.reset()
-            self._ms.machine.reset()
-            self._source, self._crash = None, None
+        """NC Reset is the channel's one Reset (``MachineService.reset``): the program and its
+        motion end, modal state to the defaults, measuring offsets cleared, the machine's alarms
+        cleared, the program deselected; mode JOG."""
+        self._ms.reset()
         return self.status()
+
+    def _reset_stop(self) -> None:
+        """Reset, first step: no new block and no new motion of a cycle."""
+        self.interpreter.request_stop()
+        workflow = self._cycle_workflow
+        if workflow is not None:
+            workflow.abort()
+
+    def _reset_wait(self) -> None:
+        """Reset, second step (the motion has been aborted): the program has ended; the channel
+        back to its reset state."""
+        thread = self._thread
+        if thread is not None and thread is not threading.current_thread():
+            thread.join(RESET_WAIT_S)
+        if self.running:
+            log.error("NC Reset: the program thread did not end within %.1f s", RESET_WAIT_S)
+            return
+        with self._lock:
+            self.interpreter.reset()
+            self._source, self._crash, self._cycle_workflow = None, None, None
+
+    def lock(self) -> dict | None:
+        """``{"mode", "program"}`` while a program runs (the screens grey out what it locks)."""
+        if not self.running:
+            return None
+        program = self._source or MDA
+        return {"mode": MDA if program == MDA else "AUTO", "program": program}
+
+    def interlock(self, action: str) -> None:
+        """The mode group: while a program runs in MDA/AUTO, motion and changes from outside
+        the program are refused (409 ``mode`` naming the program); the program's own thread
+        passes."""
+        lock = self.lock()
+        if lock is None or threading.current_thread() is self._thread or action not in LOCKED_BY_A_PROGRAM:
+            return
+        raise ModeError(f"Program {lock['program']} runs in {lock['mode']}: locked until the program ends "
+                        "(NC Stop holds it, Reset ends it)", extra={**lock, "action": action})
 
     def set_single_block(self, on: bool) -> dict:
         self.single_block = bool(on)
@@ -485,8 +592,8 @@ class NcService:
     def write_variable(self, name: str, value) -> dict:
         if self.running:
             raise ConflictError("a program is running: write the variable when it has stopped", code="busy")
-        if isinstance(value, bool) or not isinstance(value, int | float | str):
-            raise InvalidInput("value: a number or a text", field="value")
+        if not isinstance(value, str):
+            value = checks.number(value, "value")       # no bool, no NaN, no 400-digit integer
         try:
             self.variables.write(name, value)
             return {name: _json_ready(self.variables.read(name))}
@@ -502,8 +609,9 @@ class NcService:
                 thread.join(5.0)
 
 
-def _memory_backing(db: Database, kind: str):
-    """_EV[i] / _MV[i] = memory n = i + 1 of the database (the same memories JOG uses)."""
+def _memory_backing(db: Database, kind: str, may_write):
+    """_EV[i] / _MV[i] = memory n = i + 1 of the database (the same memories JOG uses);
+    ``may_write(name)`` raises when the program's starter may not write them."""
     from app.nc import CallbackBacking
 
     def read(key):
@@ -517,8 +625,13 @@ def _memory_backing(db: Database, kind: str):
         n = int(key) + 1
         if not 1 <= n <= MEMORY_COUNT:
             raise VariableError(f"_{kind}[{key}]: memory {n} is beyond the {MEMORY_COUNT} memories")
+        may_write(f"_{kind}")
+        try:        # the range of /api/memories: a program cannot store what the API refuses
+            number = check_memory_value(value, f"_{kind}[{key}]")
+        except InvalidInput as exc:
+            raise InvalidValue(exc.message) from None
         with db.unit() as unit:
-            unit.put_memory(kind, n, float(value), source="nc")
+            unit.put_memory(kind, n, number, source="nc")
 
     return CallbackBacking(read, write)
 

@@ -8,8 +8,8 @@ written frame is part of it.
 from __future__ import annotations
 
 import builtins
-import math
 
+from app import checks
 from app.errors import ConflictError, InvalidInput, NotFoundError
 from app.records import frame_out_of_range
 from db import Database
@@ -18,17 +18,6 @@ from engine.frames import GEOMETRY_AXES
 from .machine_service import MachineService
 
 FRAME_PARTS = ("trans", "fine", "rot")
-
-
-def _number(value, field: str) -> float:
-    if isinstance(value, str):
-        try:
-            value = float(value.strip().replace(",", "."))
-        except ValueError:
-            raise InvalidInput(f"{field}: {value!r} is not a number", field=field) from None
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise InvalidInput(f"{field}: must be a finite number", field=field)
-    return float(value)
 
 
 class OffsetService:
@@ -72,7 +61,7 @@ class OffsetService:
                 if axis not in allowed[part]:
                     raise InvalidInput(f"{field}: unknown axis (allowed: {', '.join(allowed[part])})",
                                        field=field)
-                number = _number(value, field)
+                number = checks.number(value, field)
                 wrong = frame_out_of_range({part: {axis: number}})
                 if wrong:
                     raise InvalidInput(wrong[1], field=wrong[0])
@@ -94,7 +83,7 @@ class OffsetService:
         part, _, axis = field.partition(".")
         if part not in FRAME_PARTS or not axis:
             raise InvalidInput(f"{field}: unknown field", field=field)
-        return self.put(name, {part: {axis: _number(text, field)}}, source=source)
+        return self.put(name, {part: {axis: checks.parse_number(text, field)}}, source=source)
 
     def audit(self, limit: int = 50, name: str | None = None, kind: str | None = None,
               before_id: int | None = None) -> builtins.list[dict]:       # list: the method above

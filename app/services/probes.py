@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from pydantic import BaseModel, ValidationError
 
+from app import checks
 from app.errors import InvalidInput, NotFoundError
 from app.records import LATHE_RECORD_KEYS, MAX_PROBE, ProbeData, ToolProbeData
 from db import Database
@@ -23,9 +24,7 @@ class _Records:
         self._db = db
 
     def check_number(self, n) -> int:
-        if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MAX_PROBE:
-            raise InvalidInput(f"n: {self.what} number must be 1..{MAX_PROBE}", field="n")
-        return n
+        return checks.integer(n, "n", lo=1, hi=MAX_PROBE)
 
     def _complete(self, stored: dict) -> dict:
         defaults = self.model().model_dump(mode="json")

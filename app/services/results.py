@@ -9,11 +9,11 @@ actual, deviation and verdict (``engine.verdict``), written in the measurement's
 
 from __future__ import annotations
 
-import math
 import re
 import socket
 from typing import Any
 
+from app import checks
 from app.errors import InvalidInput, NotFoundError
 from app.gud import GudSettings
 from app.services.settings import SettingsService
@@ -49,11 +49,7 @@ def _text(body: dict, key: str, required: bool = False) -> str | None:
 
 
 def _number(value: Any, field: str) -> float | None:
-    if value is None:
-        return None
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise InvalidInput(f"{field}: a finite number", field=field)
-    return float(value)
+    return checks.optional_number(value, field)
 
 
 def _limits(body: Any) -> dict[str, dict[str, float | None]]:
@@ -224,7 +220,9 @@ def _values(task: str, params: dict, result: dict, zero_offset: bool) -> list[tu
         axis = params.get("axis")
         value = result["position"].get(axis)
         if isinstance(value, int | float):
-            out.append((f"position {axis}", "position", float(value), setpoint.get(axis)))
+            given = params.get("setpoint")            # a number (the edge's position) or {axis: value}
+            nominal = given if isinstance(given, int | float) and not isinstance(given, bool) else setpoint.get(axis)
+            out.append((f"position {axis}", "position", float(value), nominal))
     elif not zero_offset and task != "edge.set":
         for key in POSITIONS:
             point = result.get(key)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from pydantic import ValidationError
 
+from app import checks
 from app.errors import ConflictError, InvalidInput, NotFoundError
 from app.records import MAX_TOOL, ToolData
 from db import Database
@@ -23,9 +24,7 @@ class ToolService:
 
     @staticmethod
     def check_number(t) -> int:
-        if isinstance(t, bool) or not isinstance(t, int) or not 1 <= t <= MAX_TOOL:
-            raise InvalidInput(f"t: tool number must be 1..{MAX_TOOL}", field="t")
-        return t
+        return checks.integer(t, "t", lo=1, hi=MAX_TOOL)
 
     def list(self) -> list[dict]:
         with self._db.unit(readonly=True) as unit:
@@ -102,10 +101,7 @@ class ToolService:
         if field == "name":
             value = text.strip() or None
         else:
-            try:
-                number = float(text.strip().replace(",", "."))
-            except ValueError:
-                raise InvalidInput(f"{field}: {text!r} is not a number", field=field) from None
+            number = checks.parse_number(text, field)
             value = int(number) if field in ("type", "sl") and number.is_integer() else number
         part, _, sub = field.partition(".")
         return self.put(t, {part: {sub: value}} if sub else {part: value}, source=source)

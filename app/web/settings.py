@@ -7,8 +7,10 @@ import typing
 from fastapi import APIRouter, Request
 from pydantic.fields import FieldInfo
 
+from app import checks
 from app.access.deps import needs, require
 from app.deps import SettingsDep
+from app.errors import InvalidInput
 from app.gud import GudSettings, field_groups
 from app.i18n import N_, _
 from app.web import units
@@ -67,6 +69,16 @@ def form_fields(values: dict, errors: dict[str, str], gud=None,
     return groups
 
 
+def _typed_number(raw: str, name: str, real: bool):
+    """Typed text -> the number (an int for whole-number fields); text that is none stays text and
+    the model names the field."""
+    try:
+        number = checks.parse_number(raw, name)
+    except InvalidInput:
+        return raw
+    return number if real or not number.is_integer() else int(number)
+
+
 def parse_form(form, gud=None) -> dict:
     """Form strings -> typed values (checkbox present = True; Literal ints as int; lengths and feeds
     typed in the unit the form was shown in, ``gud``, stored as mm)."""
@@ -85,11 +97,8 @@ def parse_form(form, gud=None) -> dict:
                 values[name] = raw                  # the model names the field
             continue
         options = choices(info.annotation)
-        if options and all(isinstance(o, int) for o in options):
-            try:
-                values[name] = int(raw)
-            except ValueError:
-                values[name] = raw
+        if options and all(isinstance(o, int) for o in options) or info.annotation in (int, float):
+            values[name] = _typed_number(raw, name, info.annotation is float)
         else:
             values[name] = raw
     return values

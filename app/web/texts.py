@@ -162,6 +162,12 @@ def _label_of(key: str, field_label) -> str:
 
 # the service messages (app/services, app/workflow, engine.params), most specific first
 message(r"(?P<field>[\w.+\-\[\]]+): '(?P<value>.*)' is not a number", N_("%(field)s: enter a number"))
+# the channel's mode group (app/services/nc.py, app/workflow/service.py)
+message(r"Program (?P<program>\S+) runs in (?P<mode>MDA|AUTO): locked until the program ends "
+        r"\(NC Stop holds it, Reset ends it\)",
+        N_("Program %(program)s runs in %(mode)s: locked until the program ends (NC Stop holds it, Reset ends it)"))
+message(r"The JOG measurement (?P<program>\S+) runs: a program starts when it has ended \(Reset ends it\)",
+        N_("The JOG measurement %(program)s runs: a program starts when it has ended (Reset ends it)"))
 message(r"(?P<field>[\w.+\-\[\]]+): must be a finite number", N_("%(field)s: enter a number"))
 message(r"(?P<field>[\w.+\-\[\]]+) must be a number, got .*", N_("%(field)s: enter a number"))
 message(r"(?P<field>[\w.+\-\[\]]+) must be a finite number, got .*", N_("%(field)s: enter a number"))
@@ -222,6 +228,12 @@ message(r"Input should be (?P<choices>'.*)", N_("Choose %(choices)s"))
 message(r"Not saved: (?P<n>\d+) field\(s\) need correction", N_("Not saved: %(n)s field(s) need correction"))
 message(r"Select an increment \(INC\) for a single jog step", N_("Select an increment (INC) for a single jog step"))
 message(r"Feed override must be 0\.\.120 %", N_("Feed override must be 0..120 %%"))
+# probe trust (app.workflow.probe_trust): the tail after the alarm text
+message(r"length (?P<axis>\w)-: calibrate the probe length on a known surface first",
+        N_("length %(axis)s-: calibrate the probe length on a known surface first"))
+message(r"radius: calibrate the probe in the ring gauge first", N_("radius: calibrate the probe in the ring gauge first"))
+message(r"direction (?P<keys>.+): calibrate the probe in the ring gauge in this plane first",
+        N_("direction %(keys)s: calibrate the probe in the ring gauge in this plane first"))
 
 
 # --- states and names the screens show ---------------------------------------------------------------
@@ -261,6 +273,10 @@ SERVICE_TEXTS = (
     N_("Left without activating: the compensation stays written in the WO"),
     N_("Measurement aborted by Reset"),
     N_("Measure only"),
+    # app.workflow.finish_probe.UNDECIDED_FRAME
+    N_("The ring passes cannot tell whether the pre-travel turns with the spindle: calibrated as turning with it"),
+    N_("The ring passes cannot tell whether the pre-travel turns with the spindle: "
+       "calibrated as fixed to the machine axes"),
 )
 message(r"(?P<wo>\S+) activated: it is the WO of the next measurement",
         N_("%(wo)s activated: it is the WO of the next measurement"))

@@ -87,6 +87,8 @@ def parse_decimal(text) -> Decimal:
     if sign not in (".", ","):
         raw = raw.replace(sign, ".")
     raw = raw.replace(",", ".").replace("−", "-")
+    if not raw.isascii():           # Decimal("１２") reads fullwidth digits; the NC does not (issue 25)
+        raise NumberError(raw)
     try:
         value = Decimal(raw)
     except InvalidOperation:

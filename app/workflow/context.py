@@ -128,6 +128,9 @@ class WorkflowEnv(Protocol):
 
     def post_alarm(self, code: int, text: str) -> None: ...
 
+    def interlock(self, action: str) -> None:
+        """Raise ``ModeError`` when the channel's mode refuses ``action`` (a program runs)."""
+
 
 # A finisher turns the stored points (in the context's WCS) into (answer, commit kwargs).
 Finisher = Callable[[MeasureSession, MeasuringContext, list], tuple[dict, dict]]

@@ -20,6 +20,14 @@ from engine import alarms
 from engine.calibration import evaluate_probe_task
 from engine.types import MeasuringError, ProbeRecord
 
+# the ring passes could not tell whether the pre-travel turns with the spindle (engine.calibration)
+UNDECIDED_FRAME = {
+    "probe": "The ring passes cannot tell whether the pre-travel turns with the spindle: "
+             "calibrated as turning with it",
+    "machine": "The ring passes cannot tell whether the pre-travel turns with the spindle: "
+               "calibrated as fixed to the machine axes",
+}
+
 
 def _probe_of(ctx: MeasuringContext) -> ProbeRecord:
     if ctx.probe is None or ctx.tool is None:
@@ -34,7 +42,7 @@ def _record(ctx: MeasuringContext, probe: ProbeRecord, extra: dict) -> tuple[int
     record = {
         **stored,
         "number": n,
-        "ball_diameter": float(probe.ball_diameter),
+        "ball_diameter": _nominal_ball(ctx, probe),
         "effective_diameter": float(probe.effective_diameter),
         "trigger": {k: float(v) for k, v in probe.trigger.items()},
         "skew": [float(probe.skew[0]), float(probe.skew[1])],
@@ -49,6 +57,13 @@ def _record(ctx: MeasuringContext, probe: ProbeRecord, extra: dict) -> tuple[int
         **extra,
     }
     return n, ProbeData.model_validate(record).model_dump(mode="json")
+
+
+def _nominal_ball(ctx: MeasuringContext, probe: ProbeRecord) -> float:
+    """The ball diameter of the tool data (what the operator entered); ``probe.ball_diameter`` is
+    the measured one once a ring calibration measured it (app.services.measuring)."""
+    radius = (ctx.tool or {}).get("radius")
+    return 2.0 * float(radius) if radius else float((ctx.probe_data or {}).get("ball_diameter") or probe.ball_diameter)
 
 
 def surface_height(params: dict, infeed: str) -> float:
@@ -77,11 +92,17 @@ def finish_probe_radius(session: MeasureSession, ctx: MeasuringContext, points: 
     # more than 4 directions: the direction-dependent map is stored and used for every touch
     # (engine.lobing); 4 directions replace an older map by the 4 trigger values
     lobing = values.get("lobing") if int(session.params.get("directions", 4) or 4) > 4 else None
+    ball = values.get("ball_diameter") or {}
     n, record = _record(ctx, new, {"cal_ring_diameter": float(session.params["diameter"]),
                                    "cal_wo": ctx.active_offset, "calibrated_planes": planes,
                                    "calibrated_spindle_angle": 0.0,      # the ring program ends at SPOS 0
-                                   "lobing": lobing})
+                                   "lobing": lobing,
+                                   "measured_ball_diameter": float(ball["value"]) if ball.get("measured") else None,
+                                   "pretravel_frame": values.get("pretravel_frame")})
     values["probe"] = {**values["probe"], **_calibration_view(record)}
+    decision = values.get("pretravel_frame_decision") or {}
+    if ctx.settings.pretravel_frame == "auto" and not decision.get("decided"):
+        session.warnings.append(UNDECIDED_FRAME[decision.get("frame") or "probe"])
     answer = {"result": values, "correction": None, "activated": False, "setup_support": None}
     return answer, {"offset": None, "probe_update": (n, record)}
 

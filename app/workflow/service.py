@@ -14,9 +14,9 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from app.errors import WorkflowError
+from app.errors import ModeError, WorkflowError
 from app.machine.protocol import MachineAlarm
-from app.workflow import guard
+from app.workflow import guard, probe_trust
 from app.workflow.context import (
     MEASURE_ONLY,
     MeasuringContext,
@@ -46,6 +46,34 @@ class WorkflowService:
         self._tasks = tasks
         self._lock = threading.Lock()
         self._session: MeasureSession | None = None
+        self._reset = threading.Event()        # Reset: the running measurement starts no further step
+        self._runner: threading.Thread | None = None
+
+    # --- Reset and the mode group (MachineService.on_reset / add_interlock) --------------------
+    def abort(self) -> None:
+        """Reset, first step: the running measurement starts no further motion."""
+        if self._lock.locked():
+            self._reset.set()
+
+    def wait_idle(self, timeout: float = 2.0) -> None:
+        """Reset, second step: returns when no measurement runs (at most ``timeout``)."""
+        if self._runner is threading.current_thread():
+            return
+        if self._lock.acquire(timeout=timeout):
+            self._lock.release()
+
+    def lock(self) -> dict | None:
+        """``{"mode": "JOG", "program": task}`` while a JOG measurement runs."""
+        session = self._session
+        return {"mode": "JOG", "program": session.task} if session is not None and session.running else None
+
+    def interlock(self, action: str) -> None:
+        """While a JOG measurement runs, a program may not start (409 ``mode`` naming the task)."""
+        lock = self.lock()
+        if action != "nc_run" or lock is None:
+            return
+        raise ModeError(f"The JOG measurement {lock['program']} runs: a program starts when it has ended "
+                        "(Reset ends it)", extra={**lock, "action": action})
 
     # --- sessions -----------------------------------------------------------------------
     @property
@@ -235,8 +263,16 @@ class WorkflowService:
         measurement runs in the background (the answer is 202-style: the session, ``running``
         true, its ``progress``); the session's ``answer``/``alarm`` tell how it ended."""
         session = self.get(session_id)
+        try:
+            self._env.interlock("measure")
+        except ModeError as exc:                # the screens show a WorkflowError's message
+            refusal = WorkflowError(409, "mode", exc.message)
+            refusal.extra = exc.extra
+            raise refusal from None
         if not self._lock.acquire(blocking=False):
             raise WorkflowError(409, "busy", "a measurement is already running")
+        self._reset.clear()
+        self._runner = threading.current_thread()
         try:
             spec, n, ctx = self._prepare_start(session, point)
         except BaseException:
@@ -251,6 +287,7 @@ class WorkflowService:
                 self._lock.release()
 
         def background() -> None:
+            self._runner = threading.current_thread()
             try:
                 self._run_point(session, spec, n, ctx)
             except WorkflowError:
@@ -284,10 +321,15 @@ class WorkflowService:
         if spec.needs_probe and ctx.probe is None:
             raise WorkflowError(409, "alarm", f"{alarms.PROBE_TYPE.number} {alarms.PROBE_TYPE.text}: the tool in "
                                               "the spindle is not a 3D probe (type 710); change to the probe first")
+        self._check_probe_ready(spec, ctx)
         self._check_probe_geometry(spec, ctx)
         warnings = self._warnings(spec, ctx)
         if self._refuse_override(ctx):
             raise WorkflowError(409, "override_mismatch", warnings[-1])
+        distrust = probe_trust.findings(spec, session.params, n, ctx, self._env.machine)
+        if distrust and ctx.settings.calibration_invalid == "refuse":
+            raise WorkflowError(409, distrust[0].code, distrust[0].message)
+        warnings += [f.message for f in distrust]
         if session.guard and guard.guarded(spec):
             warnings += self._guard(session, spec, n, ctx)
         session.warnings = warnings
@@ -327,6 +369,26 @@ class WorkflowService:
         answer = guard.plan_to_api(report, n, coords, ("X", "Y", "Z"))
         answer["guard"] = session.guard
         return answer
+
+    def _check_probe_ready(self, spec: TaskSpec, ctx: MeasuringContext) -> None:
+        """A probe that cannot switch refuses NC Start with an alarm, before anything moves
+        (design.md §10.4): not the tool in the spindle, not armed (radio), deflected already.
+        A controller that cannot tell (state None) is trusted."""
+        status = self._env.machine.status()
+        which = spec.probe_used
+        state = status.probe if which == "workpiece" else status.tool_probe if which == "tool" else None
+        if state is None:
+            return
+        refusal = None
+        if which == "workpiece" and spec.needs_probe and ctx.probe is not None and not state.in_spindle:
+            refusal = alarms.PROBE_NOT_IN_SPINDLE
+        elif state.armed is False:
+            refusal = alarms.PROBE_NOT_ARMED if which == "workpiece" else alarms.TOOL_PROBE_NOT_ARMED
+        elif state.deflected:
+            refusal = alarms.PROBE_DEFLECTED if which == "workpiece" else alarms.TOOL_PROBE_DEFLECTED
+        if refusal is not None:
+            self._env.post_alarm(refusal.number, refusal.text)
+            raise WorkflowError(409, "alarm", f"{refusal.number} {refusal.text}: {refusal.remedy}")
 
     def _run_point(self, session: MeasureSession, spec: TaskSpec, n: int, ctx: MeasuringContext,
                    count_steps: bool = True) -> dict:
@@ -431,7 +493,7 @@ class WorkflowService:
                                 f"{alarms.NOT_CALIBRATED_IN_PLANE.text}: calibrated in {', '.join(planes)}, "
                                 f"measuring in {ctx.plane.name}: calibrate the probe in {ctx.plane.name}")
         angle = data.get("calibrated_spindle_angle")
-        if ctx.settings.pretravel_frame == "probe" and angle is not None:
+        if (data.get("pretravel_frame") or ctx.settings.pretravel_frame) != "machine" and angle is not None:
             off = abs((ctx.spindle_angle - float(angle) + 180.0) % 360.0 - 180.0)
             if off > 1e-6:
                 raise WorkflowError(409, "spindle_orientation",
@@ -445,8 +507,6 @@ class WorkflowService:
         probe = ctx.probe
         if not spec.needs_probe or probe is None:
             return warnings
-        if spec.name != "probe.radius" and not probe.calibrated_radius:
-            warnings.append("Probe not calibrated (radius): results carry its eccentricity and pre-travel")
         if (probe.calibration_override is not None
                 and abs(probe.calibration_override - ctx.feed_override) > 1e-9
                 and spec.category == Category.WORKPIECE):
@@ -479,6 +539,8 @@ class WorkflowService:
         session.progress = progress
 
         def execute(step):
+            if self._reset.is_set():
+                raise MotionAborted("Reset")
             current = session.progress
             assert current is not None, "set above for the run, cleared only after it (_run_point, _verify)"
             done = current["step"] + 1

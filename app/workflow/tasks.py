@@ -92,6 +92,13 @@ class TaskSpec:
         return self.category in (Category.WORKPIECE, Category.PROBE_CALIBRATION)
 
     @property
+    def probe_used(self) -> str | None:
+        """The probe that switches during the task: "workpiece", "tool" (the tool probe)."""
+        if self.category in (Category.WORKPIECE, Category.PROBE_CALIBRATION):
+            return "workpiece"
+        return "tool" if self.category in (Category.TOOL_MEASURING, Category.TOOL_PROBE_CALIBRATION) else None
+
+    @property
     def corrects_zero_offset(self) -> bool:
         return Target.ZERO_OFFSET in self.targets
 

@@ -6,8 +6,9 @@ from db import Database
 
 
 @pytest.fixture
-def db_path(tmp_path: Path) -> Path:
-    return tmp_path / "data" / "hmi.db"
+def db_path(database_target: Path | str) -> Path | str:
+    """A SQLite file, or with --db-engine=postgresql a new database's URL (tests/conftest.py)."""
+    return database_target
 
 
 @pytest.fixture

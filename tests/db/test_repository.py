@@ -128,6 +128,7 @@ def test_readonly_unit_refuses_writes(db):
         assert unit.get_state("tool") is None
 
 
+@pytest.mark.sqlite_only
 def test_committed_data_is_seen_by_another_connection_and_process(db, db_path):
     other = Database(db_path)
     try:
@@ -168,6 +169,7 @@ def test_tools_round_trip_merge_and_delete(db):
                 unit.put_tool(bad_t, bad_data)
 
 
+@pytest.mark.sqlite_only
 def test_probe_records_round_trip_with_calibration_time(db, db_path):
     record = {"effective_diameter": 3.9912, "trigger": {"X-": 1.993, "X+": -1.994}, "skew": (0.01, -0.006),
               "calibrated_at": "2025-01-01T10:00:00+00:00", "calibration_feed": 300.0}

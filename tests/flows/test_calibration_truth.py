@@ -6,16 +6,16 @@ the switch comes after the pre-travel δ(dir) past contact and the latch v·τ l
 override), so a calibrated trigger value magnitude is r − δ̄ − v·τ per axis (δ̄ = mean of the two
 directions) and L1 absorbs δ(Z−) + v·τ.
 
-Known limit (engine/calibration.py docstring): a ring of unknown centre cannot tell the ring
-centre from a difference δ(+) − δ(−) on one axis, so calibrated positions probed along +j are off
-by k_j = (δ(+j) − δ(−j))/2 (the example probe: −0.5 µm in X, −1.5 µm in Y). The set-up test
-states that part explicitly; with per-axis symmetric pre-travel the set-up reaches the noise.
+Known limit (engine/calibration.py docstring): chords through the centre of a ring of unknown
+centre cannot tell the ring centre from a difference δ(+) − δ(−) on one axis, so calibrated
+positions probed along +j may be off by k_j = (δ(+j) − δ(−j))/2 (the example probe: −0.5 µm in X,
+−1.5 µm in Y). The default program adds off-centre chords (setting ``cal_chords``), which observe
+k; the set-up test allows for either.
 
-These figures (skew = e, ring centre = M + k, a set-up off by k) are those of the wave-1
-simulator, whose pre-travel is fixed to the machine axes: the scenarios that assert them say
-``"pretravel_frame": "machine"`` (WAVE1). With the default probe-frame pre-travel (design.md
-§9.8) the lobing turns with SPOS, the 0°/180° calibration observes k and the stored skew is
-e − k instead (engine/calibration.py).
+The scenarios here use the wave-1 simulator, whose pre-travel is fixed to the machine axes
+(``"pretravel_frame": "machine"``, WAVE1); the HMI's setting ``pretravel_frame`` "auto" finds
+that out from the 0°/180° passes (issue [probe-health] item 5; tests/flows/test_probe_trust.py
+for both models).
 """
 
 from __future__ import annotations
@@ -47,9 +47,13 @@ def flow(tmp_path):
 
 
 def test_radius_calibration_finds_skew_and_trigger_values(flow):
+    """The default program (off-centre chords) and the default pre-travel setting "auto": the
+    passes show that this simulator's pre-travel stays with the machine axes, and the chords
+    observe k, so each direction's trigger value and the ring centre come out exact."""
     sc = flow.sc
     answer = flow.calibrate_radius()
     result = answer["result"]
+    assert result["pretravel_frame"] == "machine" and result["pretravel_frame_decision"]["decided"]
     ecc = sc["probe"]["eccentricity"]
     assert result["skew"]["X"] == pytest.approx(ecc[0], abs=3 * NOISE)
     assert result["skew"]["Y"] == pytest.approx(ecc[1], abs=3 * NOISE)
@@ -57,15 +61,11 @@ def test_radius_calibration_finds_skew_and_trigger_values(flow):
     pre = sc["probe"]["pretravel"]
     lat = latency_path(sc)
     for axis in "XY":
-        mean_pre = (pre[f"{axis}+"] + pre[f"{axis}-"]) / 2.0
-        expected = r - mean_pre - lat
-        assert result["trigger"][f"{axis}-"] == pytest.approx(expected, abs=3 * NOISE)
-        assert result["trigger"][f"{axis}+"] == pytest.approx(-expected, abs=3 * NOISE)
-    # the ring centre up to the unobservable k (the documented limit)
+        assert result["trigger"][f"{axis}-"] == pytest.approx(r - pre[f"{axis}-"] - lat, abs=3 * NOISE)
+        assert result["trigger"][f"{axis}+"] == pytest.approx(-(r - pre[f"{axis}+"] - lat), abs=3 * NOISE)
     cx, cy, _ = sc["ring_gauge"]["center"]
-    k = k_shift(sc)
-    assert result["center"]["X"] == pytest.approx(cx + k[0], abs=3 * NOISE)
-    assert result["center"]["Y"] == pytest.approx(cy + k[1], abs=3 * NOISE)
+    assert result["center"]["X"] == pytest.approx(cx, abs=3 * NOISE)
+    assert result["center"]["Y"] == pytest.approx(cy, abs=3 * NOISE)
     assert answer["correction"] is None and answer["activated"] is False
     # the probe record: stored with how it was calibrated, bound to the probe's tool
     record = ok(flow.c.get("/api/probes/1"))
@@ -95,7 +95,9 @@ def test_length_calibration_on_a_known_surface(flow):
     assert ok(flow.c.get("/api/machine"))["tool_length"] == pytest.approx(length)
     record = ok(flow.c.get("/api/probes/1"))
     assert record["calibrated_length"] is True and record["calibrated_radius"] is True
-    assert record["trigger"]["Z-"] == pytest.approx(sc["probe"]["ball_diameter"] / 2.0)
+    # t(Z−) = r, the ball radius the ring chords measured (to their noise, ≈ 1 µm)
+    assert record["trigger"]["Z-"] == pytest.approx(sc["probe"]["ball_diameter"] / 2.0, abs=0.003)
+    assert record["trigger"]["Z-"] == pytest.approx(record["measured_ball_diameter"] / 2.0)
     assert record["cal_height"] == sc["ring_gauge"]["center"][2]
     # the new L1 is live: a set edge Z− on the block's top face reads its true height
     top = flow.part_to_mcs((100.0, 60.0, 0.0))
@@ -179,6 +181,7 @@ def test_override_mismatch_warns_is_a_real_error_and_can_refuse(flow):
 def test_active_record_follows_the_probe_tool(flow):
     sc = flow.sc
     flow.calibrate_radius()                         # record 1 (GUD probe number 1) bound to the probe
+    flow.calibrate_length()
     ok(flow.c.put("/api/settings", json={"probe_number": 2}))
     top = flow.part_to_mcs((100.0, 60.0, 0.0))
     flow.travel(top[0], top[1], top[2] + 4.0)

@@ -10,15 +10,20 @@ runs the JOG task that measures the same feature through the JOG workflow on the
 
 from __future__ import annotations
 
-from app.nc.cycles import calibration, sphere, workpiece
+from app.nc.cycles import calibration, protocol, sphere, workpiece
 from app.nc.cycles.base import CycleHost, NcMeasuring
 
 CYCLE_NAMES = ("CYCLE976", "CYCLE977", "CYCLE978", "CYCLE979", "CYCLE998", "CYCLE961", "CYCLE997", "CYCLE971")
+# logging measuring results (manual §7.1): registered when the host keeps protocol files
+PROTOCOL_CYCLES = ("CYCLE100", "CYCLE101", "CYCLE105", "CYCLE106", "CYCLE113", "CYCLE118")
 
 
 def measuring_cycles(host: CycleHost) -> dict:
     handlers = {**workpiece.handlers(host), **sphere.handlers(host), **calibration.handlers(host)}
-    return {name: handlers[name] for name in CYCLE_NAMES}
+    if getattr(host, "protocol_files", None) is None:
+        return {name: handlers[name] for name in CYCLE_NAMES}
+    log = protocol.ProtocolLog(host)        # type: ignore[arg-type]
+    return {**{name: log.logged(name, handlers[name]) for name in CYCLE_NAMES}, **log.handlers()}
 
 
-__all__ = ["CYCLE_NAMES", "CycleHost", "NcMeasuring", "measuring_cycles"]
+__all__ = ["CYCLE_NAMES", "PROTOCOL_CYCLES", "CycleHost", "NcMeasuring", "measuring_cycles"]

@@ -277,6 +277,7 @@ class Call:
                 answer = workflow.start(session.id, n)
             if spec.points > 1:
                 answer = workflow.calculate(session.id)
+            self._warn_probe((answer or {}).get("warnings") or [])
             return answer or {}
         except WorkflowError as exc:
             raise self.alarm_of(exc, session) from None
@@ -287,6 +288,15 @@ class Call:
             definition = alarms.NC_WRITE_PROTECTED if exc.code in ("access_level", "unauthenticated") \
                 else alarms.NC_VALUE_RANGE
             raise CycleAlarm(definition, exc.message) from None
+
+    def _warn_probe(self, warnings: Sequence[str]) -> None:
+        """A warning of the measurement that names an alarm (an uncalibrated or invalid probe,
+        app.workflow.probe_trust) becomes the channel's message: a program warns as the screen does."""
+        for text in warnings:
+            code = str(text)[:5]
+            definition = alarms.by_number(int(code)) if code.isdigit() else None
+            if definition is not None:
+                self.ctx.warn(definition, f"CYCLE{self.number}: {str(text)[6:]}")
 
     @staticmethod
     def alarm_of(exc: WorkflowError, session) -> CycleAlarm:
@@ -299,6 +309,10 @@ class Call:
             return CycleAlarm(definition or alarms.NC_INTERNAL, str(alarm.get("text") or exc.message))
         if exc.code == "access_level":
             return CycleAlarm(alarms.NC_WRITE_PROTECTED, exc.message)
+        if exc.code in ("not_calibrated", "calibration_invalid", "repeatability"):     # app.workflow.probe_trust
+            number = exc.message[:5]
+            found = alarms.by_number(int(number)) if number.isdigit() else None
+            return CycleAlarm(found or alarms.CALIBRATION_INVALID, exc.message[6:])
         if exc.code in ("invalid_param", "invalid_target", "unknown_task"):
             return CycleAlarm(alarms.WRONG_VARIANT, exc.message)
         return CycleAlarm(alarms.NC_VALUE_RANGE, exc.message)

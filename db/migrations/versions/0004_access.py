@@ -51,7 +51,8 @@ def upgrade() -> None:
         batch.add_column(sa.Column("kind", sa.String(16), nullable=False, server_default="offset"))
         batch.add_column(sa.Column("who", sa.String(80), nullable=True))
         batch.add_column(sa.Column("who_level", sa.Integer(), nullable=True))
-    op.execute("UPDATE offset_audit SET kind = 'memory' WHERE offset LIKE 'EV%' OR offset LIKE 'MV%'")
+    # "offset" quoted: a reserved word in PostgreSQL
+    op.execute("""UPDATE offset_audit SET kind = 'memory' WHERE "offset" LIKE 'EV%' OR "offset" LIKE 'MV%'""")
     op.create_index("ix_offset_audit_kind_id", "offset_audit", ["kind", "id"])
 
 
