@@ -441,6 +441,23 @@ class Interpreter:
 
     # --- execution ---------------------------------------------------------------------------------
     def _go(self, single: bool) -> RunResult:
+        program = self._begin()
+        last: BlockRef | None = None
+        watch = _Watchdog(self)
+        try:
+            while True:
+                result, last = self._next_block(program, watch, single, last)
+                if result is not None:
+                    return result
+        except NcAlarm as alarm:
+            return self._finish(_ALARM, None, BlockRef.of(program.blocks[self._pc]), alarm)
+        except BaseException:
+            with self._lock:
+                self._state = _ALARM
+            raise
+
+    def _begin(self) -> n.Program:
+        """NC Start: the loaded program runs from its current block."""
         with self._lock:
             if self._program is None:
                 raise NcStateError("no program loaded")
@@ -451,43 +468,37 @@ class Interpreter:
                                    "load it again or press Reset")
             self._state = _RUNNING
             self._stop.clear()
-        program = self._program
-        last: BlockRef | None = None
-        watch = _Watchdog(self)
-        try:
-            while True:
-                if self._pc >= len(program.blocks):
-                    return self._finish(_DONE, "end", last)
-                if self._stop.is_set():
-                    return self._finish(_STOPPED, "stop_request", last, next_block=True)
-                block = program.blocks[self._pc]
-                ref = BlockRef.of(block)
-                with self._lock:
-                    self._current = ref
-                if self._on_block is not None:
-                    self._on_block(ref)
-                control = self._execute(block)
-                last = ref
-                if control.kind == "end":
-                    return self._finish(_DONE, control.reason, last)
-                watch.check(block, control)
-                if control.kind == "jump":
-                    assert control.target is not None       # a jump names its block (_execute_block)
-                    self._pc = control.target
-                else:
-                    self._pc += 1
-                if control.kind == "stop":
-                    return self._finish(_STOPPED, control.reason, last, next_block=True)
-                if single:
-                    if self._pc >= len(program.blocks):
-                        return self._finish(_DONE, "end", last)
-                    return self._finish(_STOPPED, "single_block", last, next_block=True)
-        except NcAlarm as alarm:
-            return self._finish(_ALARM, None, BlockRef.of(program.blocks[self._pc]), alarm)
-        except BaseException:
-            with self._lock:
-                self._state = _ALARM
-            raise
+            return self._program
+
+    def _next_block(self, program: n.Program, watch: _Watchdog, single: bool,
+                    last: BlockRef | None) -> tuple[RunResult | None, BlockRef | None]:
+        """Execute the block at ``_pc``: (the run's result if it ends here, the block executed last)."""
+        if self._pc >= len(program.blocks):
+            return self._finish(_DONE, "end", last), last
+        if self._stop.is_set():
+            return self._finish(_STOPPED, "stop_request", last, next_block=True), last
+        block = program.blocks[self._pc]
+        ref = BlockRef.of(block)
+        with self._lock:
+            self._current = ref
+        if self._on_block is not None:
+            self._on_block(ref)
+        control = self._execute(block)
+        if control.kind == "end":
+            return self._finish(_DONE, control.reason, ref), ref
+        watch.check(block, control)
+        if control.kind == "jump":
+            assert control.target is not None       # a jump names its block (_control)
+            self._pc = control.target
+        else:
+            self._pc += 1
+        if control.kind == "stop":
+            return self._finish(_STOPPED, control.reason, ref, next_block=True), ref
+        if single:
+            if self._pc >= len(program.blocks):
+                return self._finish(_DONE, "end", ref), ref
+            return self._finish(_STOPPED, "single_block", ref, next_block=True), ref
+        return None, ref
 
     def _finish(self, state: str, reason: str | None, block: BlockRef | None, alarm: NcAlarm | None = None,
                 next_block: bool = False) -> RunResult:
@@ -732,23 +743,7 @@ class Interpreter:
         coords = self._located(first_word, lambda: self._coordinates(new, suppress))
         position = self._located(first_word, self.runtime.position)
         offsets = _EMPTY_OFFSETS if suppress else new.measuring
-        shift = np.array([offsets.offset(a) for a in GEOMETRY_AXES])
-        target: dict[str, float] = {}
-        geometry = [a for a in axis_values if a in GEOMETRY_AXES]
-        if geometry:
-            now_prog = coords.tip_wcs(position) - shift
-            prog = now_prog.copy()
-            for a in geometry:
-                i = GEOMETRY_AXES.index(a)
-                value = new.length_to_mm(axis_values[a][1])
-                prog[i] = value if new.distance == "G90" else now_prog[i] + value
-            axes = coords.axes_for(prog + shift)
-            target.update({a: float(v) for a, v in zip(GEOMETRY_AXES, axes, strict=True)})
-        for a, (_word, value) in axis_values.items():
-            if a in GEOMETRY_AXES:
-                continue
-            now = coords.rotary_wcs(a, position[a])
-            target[a] = coords.rotary_mcs(a, value if new.distance == "G90" else now + value)
+        target = _target_mcs(coords, position, new, axis_values, offsets)
         if not all(math.isfinite(v) for v in target.values()):
             raise self._alarm(first_word, alarms.NC_VALUE_RANGE, "the target position is not a finite number")
         if kind == "G0":
@@ -932,42 +927,31 @@ class Interpreter:
                 self._check_expr(a)
 
     def _check_var(self, var: n.Var, write: bool) -> None:
-        v = self.variables
-        if not v.has(var.name):
-            hint = ""
-            if var.name in GEOMETRY_AXES or len(var.name) == 1:
-                hint = " (an axis is only an index here, e.g. $AA_MM[X])"
-            raise NcSyntaxError(f"{var.name} is not a known variable{hint}; define local variables with DEF",
-                                var.pos.line, var.pos.column, alarm=alarms.NC_NAME_UNKNOWN)
-        d = v.definition(var.name)
+        d = self._known_var(var)
         if write and not d.writable:
             raise NcSyntaxError(f"{d.name} is written by the control only", var.pos.line, var.pos.column,
                                 alarm=alarms.NC_WRITE_PROTECTED)
-        if d.is_array and not var.indices:
-            raise NcSyntaxError(f"{d.name} is an array: name the element, e.g. {d.name}[0]",
-                                var.pos.line, var.pos.column, alarm=alarms.NC_ARRAY_INDEX)
-        if not d.is_array and var.indices:
-            raise NcSyntaxError(f"{d.name} is not an array and takes no index", var.pos.line, var.pos.column,
-                                alarm=alarms.NC_ARRAY_INDEX)
+        _check_indexing(d, var)
         if d.axis_indexed:
-            if len(var.indices) != 1 or not (isinstance(var.indices[0], n.Var) and not var.indices[0].indices
-                                             and var.indices[0].name in GEOMETRY_AXES + ("A", "B", "C")):
-                raise NcSyntaxError(f"{d.name} takes an axis name as index, e.g. {d.name}[X]",
-                                    var.pos.line, var.pos.column, alarm=alarms.NC_ARRAY_INDEX)
             return
-        if d.shape and len(var.indices) != len(d.shape):
-            raise NcSyntaxError(f"{d.name} needs {len(d.shape)} ind{'ex' if len(d.shape) == 1 else 'ices'}",
-                                var.pos.line, var.pos.column, alarm=alarms.NC_ARRAY_INDEX)
-        constant = []
         for i in var.indices:
             self._check_expr(i)
-            constant.append(i.value if isinstance(i, n.Num) else None)
+        constant = [i.value if isinstance(i, n.Num) else None for i in var.indices]
         if constant and all(c is not None for c in constant):
             try:
                 d.key(tuple(constant))
             except VariableError as e:
                 where = var.indices[0].pos
                 raise NcSyntaxError(e.message, where.line, where.column, alarm=e.alarm) from None
+
+    def _known_var(self, var: n.Var) -> VarDef:
+        if not self.variables.has(var.name):
+            hint = ""
+            if var.name in GEOMETRY_AXES or len(var.name) == 1:
+                hint = " (an axis is only an index here, e.g. $AA_MM[X])"
+            raise NcSyntaxError(f"{var.name} is not a known variable{hint}; define local variables with DEF",
+                                var.pos.line, var.pos.column, alarm=alarms.NC_NAME_UNKNOWN)
+        return self.variables.definition(var.name)
 
 
 # --- helpers -----------------------------------------------------------------------------------------
@@ -1029,6 +1013,48 @@ def _local_definitions(program: n.Program, variables: Variables) -> list[VarDef]
                 default = "" if w.type == "STRING" else 0
                 out.append(VarDef(item.name, w.type, item.dims, default, length=w.length, scope="LUD"))
     return out
+
+
+def _target_mcs(coords: Coordinates, position: Mapping[str, float], new: ModalState, axis_values,
+                offsets: MeasuringOffsets) -> dict[str, float]:
+    """The MCS axis targets of a block's axis words: geometry axes through the frame and the tool
+    length (measuring offsets shift the programmed point), rotary axes by their frame offset;
+    G90 absolute, G91 from where the tool tip is."""
+    shift = np.array([offsets.offset(a) for a in GEOMETRY_AXES])
+    target: dict[str, float] = {}
+    geometry = [a for a in axis_values if a in GEOMETRY_AXES]
+    if geometry:
+        now_prog = coords.tip_wcs(position) - shift
+        prog = now_prog.copy()
+        for a in geometry:
+            i = GEOMETRY_AXES.index(a)
+            value = new.length_to_mm(axis_values[a][1])
+            prog[i] = value if new.distance == "G90" else now_prog[i] + value
+        axes = coords.axes_for(prog + shift)
+        target.update({a: float(v) for a, v in zip(GEOMETRY_AXES, axes, strict=True)})
+    for a, (_word, value) in axis_values.items():
+        if a not in GEOMETRY_AXES:
+            now = coords.rotary_wcs(a, position[a])
+            target[a] = coords.rotary_mcs(a, value if new.distance == "G90" else now + value)
+    return target
+
+
+def _check_indexing(d: VarDef, var: n.Var) -> None:
+    """An array is named with its indices (an axis name where it is indexed by axes), a scalar without."""
+    def refuse(message: str) -> NcSyntaxError:
+        return NcSyntaxError(message, var.pos.line, var.pos.column, alarm=alarms.NC_ARRAY_INDEX)
+
+    if d.is_array and not var.indices:
+        raise refuse(f"{d.name} is an array: name the element, e.g. {d.name}[0]")
+    if not d.is_array and var.indices:
+        raise refuse(f"{d.name} is not an array and takes no index")
+    if d.axis_indexed:
+        index = var.indices[0] if len(var.indices) == 1 else None
+        if not (isinstance(index, n.Var) and not index.indices and index.name in GEOMETRY_AXES + ("A", "B", "C")):
+            raise refuse(f"{d.name} takes an axis name as index, e.g. {d.name}[X]")
+        return
+    if d.shape and len(var.indices) != len(d.shape):
+        raise refuse(f"{d.name} needs {len(d.shape)} ind{'ex' if len(d.shape) == 1 else 'ices'}")
 
 
 def _truth(value, pos) -> bool:
