@@ -358,30 +358,37 @@ def _hint(expected: set[str]) -> str:
     return ": expected " + (", ".join(words[:-1]) + " or " + words[-1] if len(words) > 1 else words[0])
 
 
+_BLOCK_SKIP = ": block skip (/) is not part of this control's language"
+
+
+def _token_message(e: UnexpectedToken, line: int) -> str:
+    prev = _last_token(getattr(getattr(e, "state", None), "value_stack", None))
+    if prev is None and e.token_history:
+        prev = e.token_history[-1]
+    tok = e.token
+    after = _after(prev, line)
+    message = f"the block ends too early{after}" if tok.type == "_NL" else f"unexpected {_describe(tok)}{after}"
+    if tok.value == "/" and after == " at the start of the block":
+        return message + _BLOCK_SKIP
+    return message + _hint(set(e.expected or ()))
+
+
+def _character_message(e: UnexpectedCharacters, line: int) -> str:
+    prev = e.token_history[-1] if getattr(e, "token_history", None) else None
+    message = f"unexpected character '{e.char}'{_after(prev, line)}"
+    if e.char == "/" and (prev is None or prev.line != line):
+        message += _BLOCK_SKIP
+    return message
+
+
 def _syntax_error(e: UnexpectedInput, lines: list[str]) -> NcSyntaxError:
     line = getattr(e, "line", None) or 1
     column = getattr(e, "column", None) or 1
     text = lines[line - 1] if 0 < line <= len(lines) else None
     if isinstance(e, UnexpectedToken):
-        stack = getattr(getattr(e, "state", None), "value_stack", None)
-        prev = _last_token(stack)
-        if prev is None and e.token_history:
-            prev = e.token_history[-1]
-        tok = e.token
-        if tok.type == "_NL":
-            message = f"the block ends too early{_after(prev, line)}"
-        else:
-            message = f"unexpected {_describe(tok)}{_after(prev, line)}"
-        if tok.value == "/" and _after(prev, line) == " at the start of the block":
-            message += ": block skip (/) is not part of this control's language"
-        else:
-            message += _hint(set(e.expected or ()))
+        message = _token_message(e, line)
     elif isinstance(e, UnexpectedCharacters):
-        prev = e.token_history[-1] if getattr(e, "token_history", None) else None
-        char = e.char
-        message = f"unexpected character '{char}'{_after(prev, line)}"
-        if char == "/" and (prev is None or prev.line != line):
-            message += ": block skip (/) is not part of this control's language"
+        message = _character_message(e, line)
     elif isinstance(e, UnexpectedEOF):
         message = "the program ends too early"
     else:  # pragma: no cover - lark has no other kinds
@@ -480,46 +487,48 @@ def _assemble(raw_blocks, source: str, lines: list[str], name: str) -> n.Program
     seen_instruction = False
     for kind, items in raw_blocks:
         if kind == "HEADER":
-            text = lines[items.line - 1].strip()
             if blocks or header is not None:
                 raise NcSyntaxError("the program name line (%...) must be the first line", items.line, items.column,
-                                    block_text=text)
+                                    block_text=lines[items.line - 1].strip())
             header = items.value
             continue
-        line, column = _block_start(items)
-        text = lines[line - 1].strip()
-        number = None
-        label = None
-        words: list = []
-        for child in items:
-            if child is None:
-                continue
-            if isinstance(child, Token) and child.type == "BLOCKNO":
-                number = int(child.value[1:])
-            elif isinstance(child, tuple) and child[0] == "LABEL":
-                tok = child[1]
-                label = tok.value.upper()
-                if label in labels:
-                    raise NcSyntaxError(f"label {label} is defined twice", tok.line, tok.column, block_text=text)
-                labels[label] = len(blocks)
-            else:
-                words.extend(child)
-        block = n.Block(len(blocks), line, text, number, label, tuple(words), n.Pos(line, column))
-        try:
-            _check_block(block)
-        except NcSyntaxError as err:
-            err.block_text = text
-            raise
-        is_def = any(isinstance(w, n.Define) for w in words)
+        block = _block(items, len(blocks), lines, labels)
+        is_def = any(isinstance(w, n.Define) for w in block.words)
         if is_def and seen_instruction:
-            raise NcSyntaxError("DEF must come before the first instruction of the program", line,
-                                words[0].pos.column, block_text=text)
-        if words and not is_def:
-            seen_instruction = True
+            raise NcSyntaxError("DEF must come before the first instruction of the program", block.line,
+                                block.words[0].pos.column, block_text=block.text)
+        seen_instruction = seen_instruction or bool(block.words and not is_def)
         blocks.append(block)
     program = n.Program(name, source, tuple(blocks), header, labels, jump_targets(blocks))
     _check_jumps(program)
     return program
+
+
+def _block(items, index: int, lines: list[str], labels: dict[str, int]) -> n.Block:
+    """One block from the parser's items (N number, label, words), checked; its label recorded."""
+    line, column = _block_start(items)
+    text = lines[line - 1].strip()
+    number = None
+    label = None
+    words: list = []
+    for child in items:
+        if isinstance(child, Token) and child.type == "BLOCKNO":
+            number = int(child.value[1:])
+        elif isinstance(child, tuple) and child[0] == "LABEL":
+            tok = child[1]
+            label = tok.value.upper()
+            if label in labels:
+                raise NcSyntaxError(f"label {label} is defined twice", tok.line, tok.column, block_text=text)
+            labels[label] = index
+        elif child is not None:
+            words.extend(child)
+    block = n.Block(index, line, text, number, label, tuple(words), n.Pos(line, column))
+    try:
+        _check_block(block)
+    except NcSyntaxError as err:
+        err.block_text = text
+        raise
+    return block
 
 
 def _err(word, message: str, **kw) -> NcSyntaxError:
