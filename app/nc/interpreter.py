@@ -38,6 +38,7 @@ from .errors import NcAlarm, NcRuntimeError, NcSyntaxError
 from .expressions import FUNCTIONS, EvalError, Evaluator
 from .modal import (
     DISTANCE,
+    FEED_TYPE,
     GEOMETRY_AXES,
     M_END,
     M_END_RESET,
@@ -581,6 +582,8 @@ class Interpreter:
             new = new.replace(distance=gcodes[DISTANCE].name)
         if UNITS in gcodes:
             new = new.replace(units=gcodes[UNITS].name)
+        if FEED_TYPE in gcodes:
+            new = new.replace(feed_type=gcodes[FEED_TYPE].name)
         if OFFSET in gcodes:
             new = new.replace(offset=gcodes[OFFSET].name)
             offset = new.offset
@@ -664,10 +667,14 @@ class Interpreter:
             plan.motion_kind = "G100"
         elif plan.axis_values:
             plan.motion_kind = "MEAS" if plan.meas is not None else plan.new.motion
-        if plan.motion_kind in ("G1", "MEAS", "G100") and plan.new.feed is None:
+        if plan.motion_kind in ("G1", "MEAS", "G100") and plan.new.path_feed() is None:
             first = next(iter(plan.axis_values.values()))[0]
-            raise self._alarm(first, alarms.NC_FEED_MISSING,
-                              f"{'G100' if plan.motion_kind == 'G100' else 'G1'}: no feed programmed; program F")
+            what = "G100" if plan.motion_kind == "G100" else "G1"
+            if plan.new.feed is not None:           # G95 with the spindle standing
+                raise self._alarm(first, alarms.NC_FEED_MISSING,
+                                  f"{what}: G95 is a feed per revolution and the spindle stands: program M3/M4 "
+                                  "with S, or G94")
+            raise self._alarm(first, alarms.NC_FEED_MISSING, f"{what}: no feed programmed; program F")
 
     # --- commands (phase 2): physical facts that happened stay ---------------------------------------
     def _command_tool(self, plan: _Plan) -> None:
@@ -750,7 +757,7 @@ class Interpreter:
             self._located(first_word, lambda: self.runtime.move(target, None))
             return None
         if kind == "G1":
-            self._located(first_word, lambda: self.runtime.move(target, new.feed))
+            self._located(first_word, lambda: self.runtime.move(target, new.path_feed()))
             return None
         word, value = meas
         if any(a not in GEOMETRY_AXES for a in axis_values):
@@ -758,7 +765,7 @@ class Interpreter:
         if all(abs(target[a] - float(position[a])) < 1e-9 for a in GEOMETRY_AXES):
             raise self._alarm(word, alarms.NO_MEASURING_PATH,
                               f"{word.kind}: the probe is already at the programmed end point")
-        feed = new.feed
+        feed = new.path_feed()
         assert feed is not None                         # _execute_block refused MEAS/MEAW without F
         result = self._located(first_word, lambda: self.runtime.measure(target, feed, word.kind == "MEAS"))
         # $AA_MW is given in the active WCS, also when G53 suppressed the frames of this block
@@ -804,7 +811,7 @@ class Interpreter:
         end[i] = target + math.copysign(fa, path)
         axes = coords.axes_for(end)
         mcs = {a: float(v) for a, v in zip(GEOMETRY_AXES, axes, strict=True)}
-        feed = new.feed
+        feed = new.path_feed()
         assert feed is not None                         # _execute_block refused G100 without F
         result = self._located(word, lambda: self.runtime.measure(mcs, feed, True))
         if not result.triggered:

@@ -174,6 +174,11 @@ class _ToNodes(Transformer):
         if name in AXIS_LETTERS or name in ("F", "S", "T", "D", "SPOS", "MEAS", "MEAW"):
             raise NcSyntaxError(f"{name} needs a value (e.g. {name}10 or {name}=R1)"
                                 if len(name) == 1 else f"{name} needs a value: {name}=...", *_lc(pos))
+        if name == "SUPA":
+            # SUPA suppresses the frames like G53 and also handwheel offsets, external zero offsets
+            # and PRESET (840D Fundamentals, "Frame suppression"): this control has none of those,
+            # so SUPA is G53 here (manual listings §6: N30 SUPA G0 Z100)
+            return n.GCode(53, pos)
         if name in _STRUCTURED:
             raise NcSyntaxError(f"{name}: structured control statements are not part of this control's "
                                 f"language (use IF ... GOTOF/GOTOB with labels)", *_lc(pos))
