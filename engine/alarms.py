@@ -274,7 +274,7 @@ NC_SYNTAX = _define(
 NC_G_FUNCTION_UNKNOWN = _define(
     12470, "NC_G_FUNCTION_UNKNOWN", "G function is unknown", "未知的G功能",
     "This control knows G0 G1 G17-G19 G53 G54-G57 G500 G505-G599 G70 G71 G700 G710 G90 G91 "
-    "G100-G102: correct the G function.")
+    "G94 G95 G100-G102 and SUPA: correct the G function.")
 NC_NAME_UNKNOWN = _define(
     12550, "NC_NAME_UNKNOWN", "Name not defined or option not available", "名称未定义或选件不存在",
     "Check the spelling of the variable, function or cycle name; define local variables with DEF.")

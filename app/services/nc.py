@@ -222,7 +222,7 @@ class NcMeasuringEnv:
         return dataclasses.replace(setup, plane=self._plane, settings=self._gud(setup.settings))
 
     def measuring_context(self):
-        ctx = self._base.measuring_context()
+        ctx = self._base.measuring_context(probe_number=self._settings.get("probe_record"))
         return dataclasses.replace(ctx, plane=self._plane, settings=self._gud(ctx.settings))
 
     def commit_measurement(self, *, log_entry: dict, **commit):
