@@ -274,7 +274,7 @@ NC_SYNTAX = _define(
 NC_G_FUNCTION_UNKNOWN = _define(
     12470, "NC_G_FUNCTION_UNKNOWN", "G function is unknown", "未知的G功能",
     "This control knows G0 G1 G17-G19 G53 G54-G57 G500 G505-G599 G70 G71 G700 G710 G90 G91 "
-    "G100-G102: correct the G function.")
+    "G94 G95 G100-G102 and SUPA: correct the G function.")
 NC_NAME_UNKNOWN = _define(
     12550, "NC_NAME_UNKNOWN", "Name not defined or option not available", "名称未定义或选件不存在",
     "Check the spelling of the variable, function or cycle name; define local variables with DEF.")
@@ -315,6 +315,16 @@ NC_INTERNAL = _define(
     65199, "NC_INTERNAL", "Internal error of the part-program interpreter", "零件程序解释器内部错误",
     "Note the block and the message, press Reset and report it.")
 
+# Product-defined: the start guard (issue 24 §1, design.md §10.1). Nothing has moved; the probe is intact.
+START_GUARD_COLLISION = _define(
+    65300, "START_GUARD_COLLISION", "Start guard: the planned path would run into material",
+    "启动保护：计划路径会撞到材料",
+    "Nothing moved. Position the probe as the measuring screen's picture shows (above the feature, "
+    "clear of it) or correct the parameters named in the message, then press NC Start again.")
+START_GUARD_LIMIT = _define(
+    65301, "START_GUARD_LIMIT", "Start guard: the planned path leaves the travel range",
+    "启动保护：计划路径超出行程范围",
+    "Nothing moved. Start the measurement farther from the axis limits, or shorten the measuring path.")
 # --- probe state at NC Start (design.md §10.4) ----------------------------------------------------
 # Product-defined (840D user alarm range): a measuring task starts only with a probe that can switch.
 PROBE_NOT_ARMED = _define(

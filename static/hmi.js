@@ -222,28 +222,51 @@
 
   // --- continuous jog: press and hold (only when the MCP is in "Cont" mode). Hold-to-run: the
   // jog is renewed every RENEW_MS while the key is held; the server stops the axis 0.5 s after
-  // the last renewal, so a lost tab, network or server stops it too (design.md §9.1)
+  // the last renewal, so a lost tab, network or server stops it too (design.md §9.1). Each key
+  // press has a number and the tab an id (issue 24 §6): the release names the press, so a
+  // renewal still on its way behind the release is ignored; the release goes out at once (fetch,
+  // not behind queued htmx requests); the server also stops the jog when this tab's live feed
+  // (static/live.js, same tab id) drops.
   var RENEW_MS = 150;
-  var holding = null;     // {key, stop, timer}
+  var holding = null;     // {key, stop, timer, press}
+  var presses = 0;
+  function tabId() {
+    var body = document.body;
+    if (!body.dataset.tab) body.dataset.tab = Math.random().toString(36).slice(2) + Date.now().toString(36);
+    return body.dataset.tab;
+  }
+  window.hmiTabId = tabId;
+  function csrfHeaders() {
+    try { return JSON.parse(document.body.getAttribute("hx-headers") || "{}"); } catch (e) { return {}; }
+  }
+  function send(url, values) {       // straight out, keepalive: also while the page goes away
+    var headers = csrfHeaders();
+    headers["Content-Type"] = "application/x-www-form-urlencoded";
+    return fetch(url, { method: "POST", body: new URLSearchParams(values).toString(), headers: headers,
+                        credentials: "same-origin", keepalive: true }).catch(function () {});
+  }
   function release() {
     if (!holding) return;
     holding.key.classList.remove("pressed");
     clearInterval(holding.timer);
-    var stop = holding.stop;
+    var stop = holding.stop, press = holding.press;
     holding = null;
-    post(stop);
+    send(stop, { tab: tabId(), press: String(press) });
   }
   document.addEventListener("pointerdown", function (event) {
     var key = event.target.closest("#mcp[data-increment='cont'] [data-jog]");
     if (!key) return;
     event.preventDefault();
+    if (holding) release();
     var mcp = key.closest("#mcp");
-    var start = { url: mcp.dataset.jogStart, values: { direction: key.dataset.jog, axis: mcp.dataset.axis } };
+    presses += 1;
+    var values = { direction: key.dataset.jog, axis: mcp.dataset.axis, tab: tabId(), press: String(presses) };
     key.classList.add("pressed");
     if (key.setPointerCapture) key.setPointerCapture(event.pointerId);
-    post(start.url, start.values);
-    holding = { key: key, stop: mcp.dataset.jogStop,
-                timer: setInterval(function () { post(start.url, start.values); }, RENEW_MS) };
+    post(mcp.dataset.jogStart, values);           // the first one through htmx: its message shows
+    var url = mcp.dataset.jogStart;
+    holding = { key: key, stop: mcp.dataset.jogStop, press: presses,
+                timer: setInterval(function () { send(url, values); }, RENEW_MS) };
   });
   ["pointerup", "pointercancel", "lostpointercapture"].forEach(function (name) {
     document.addEventListener(name, release);

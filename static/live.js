@@ -116,7 +116,9 @@
     }
   }
 
-  var source = new EventSource(url);
+  // the tab's id (static/hmi.js): the server stops this tab's held jog when the feed drops
+  var tab = window.hmiTabId ? window.hmiTabId() : "";
+  var source = new EventSource(tab ? url + (url.indexOf("?") < 0 ? "?" : "&") + "tab=" + encodeURIComponent(tab) : url);
   source.addEventListener("open", function () { seen(); });
   source.addEventListener("machine", function (event) {
     seen();

@@ -10,7 +10,7 @@ const COLOR = {
   block: 0x8fa3b8, hole: 0x2b3640, spigot: 0x6f8aa6, pocket: 0x2b3640, boss: 0x6f8aa6, prism: 0x8fa3b8,
   sphere: 0x9db0c4, ring: 0xc9a227, tool_probe: 0x7a5fa8, probe: 0xf39200, shank: 0x9aa3ab,
   move: 0x35506b, probing: 0xd32f2f, contact: 0xd32f2f, touch: 0x2e7d32, measured: 0x0057b8,
-  table: 0xd7dde3, grid: 0xb5bec7,
+  table: 0xd7dde3, grid: 0xb5bec7, refused: 0xff00c8,
 };
 const PROBE_POLL_MS = 150;        // as the position display
 const SCENE_POLL_MS = 1000;
@@ -383,7 +383,9 @@ class View3D {
     const segments = plan ? plan.segments : [];
     segments.forEach((s) => {
       const probing = s.kind === 'probe';
-      this.layers.plan.add(polyline([v3(s.from), v3(s.to)], probing ? COLOR.probing : COLOR.move, { dashed: !probing }));
+      const refused = s.verdict === 'collision' || s.verdict === 'limit';     // the start guard's refusal
+      const color = refused ? COLOR.refused : (probing ? COLOR.probing : COLOR.move);
+      this.layers.plan.add(polyline([v3(s.from), v3(s.to)], color, { dashed: !probing && !refused }));
       if (probing) {
         const dot = new THREE.Mesh(new THREE.SphereGeometry(0.8, 12, 8), solidMaterial(COLOR.contact));
         dot.position.copy(v3(s.to));
@@ -391,8 +393,9 @@ class View3D {
       }
     });
     this.el.dataset.plan = String(segments.length);
+    this.el.dataset.planRefused = plan && plan.refused_step ? String(plan.refused_step) : '';
     const out = this.out('plan');
-    if (out) out.textContent = plan && segments.length ? `P${plan.point}` : '–';
+    if (out) out.textContent = plan && segments.length ? `P${plan.point}${plan.refused_step ? ' ✕ ' + plan.refused_step : ''}` : '–';
   }
 
   buildTouches(touches, radius) {

@@ -18,6 +18,7 @@ from app.deps import (
     ToolProbesDep,
     ToolsDep,
 )
+from app.services.memories import WRITE_FUNCTION as MEMORY_WRITE
 from app.services.undo import UNDO_FUNCTION, undo
 
 router = APIRouter(tags=["data"])
@@ -163,7 +164,7 @@ def get_memory(kind: MemoryKind, n: MemoryNumber, memories: MemoriesDep) -> dict
     return memories.get(kind, n)
 
 
-@router.put("/memories/{kind}/{n}", name="api_memory_put", dependencies=[needs("tools")])
+@router.put("/memories/{kind}/{n}", name="api_memory_put", dependencies=[needs(MEMORY_WRITE)])
 def put_memory(kind: MemoryKind, n: MemoryNumber, body: MemoryBody, memories: MemoriesDep) -> dict:
     """Writes the memory (audited)."""
     return memories.put(kind, n, body.value)

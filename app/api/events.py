@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import AsyncIterator
 from typing import Annotated
 
 from fastapi import APIRouter, Query, Request
@@ -19,7 +20,10 @@ router = APIRouter(tags=["live"])
                              "description": "`machine` and `session` events, JSON data with a `seq` number"}})
 async def events(request: Request, machine: MachineDep, workflow: WorkflowDep,
                  limit: Annotated[int | None, Query(ge=1, le=100_000, description="close after this many events")]
-                 = None):
+                 = None,
+                 tab: Annotated[str | None, Query(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9_-]+$",
+                                                  description="the browser tab: its held jog stops when "
+                                                              "this feed drops (issue 24 §6)")] = None):
     """Server-sent events: ``machine`` (the ``GET /api/machine`` body) 20 times a second while the
     machine moves, on every change and at least 4 times a second at rest; ``session`` (the
     ``GET /api/measure/{id}`` body, ``{"id": null}`` without a session) on every change, e.g. the
@@ -29,5 +33,19 @@ async def events(request: Request, machine: MachineDep, workflow: WorkflowDep,
         return None if current is None else current.to_api()
 
     feed = LiveFeed(machine.status, session, machine.changes)
-    return EventSourceResponse(feed.events(limit, request.is_disconnected), ping=15,
+    stream = feed.events(limit, request.is_disconnected)
+    if tab is not None:
+        machine.tab_back(tab)
+        stream = _held_jog_stops_with(stream, machine, tab)
+    return EventSourceResponse(stream, ping=15,
                                headers={"Cache-Control": "no-store", "X-Accel-Buffering": "no"})
+
+
+async def _held_jog_stops_with(stream: AsyncIterator[dict], machine, tab: str) -> AsyncIterator[dict]:
+    """The feed of ``tab``; when it ends (the browser died, the tab closed, the network went) the
+    jog that tab holds stops at once, not only when its renewals run out."""
+    try:
+        async for item in stream:
+            yield item
+    finally:
+        machine.tab_gone(tab)       # synchronous: a cancelled stream cannot await any more

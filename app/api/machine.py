@@ -33,6 +33,11 @@ class ContinuousJogBody(_Body):
     axis: str
     direction: Literal[-1, 1]
     feed: StrictFloat | None = None
+    # issue 24 §6: the tab (its live feed's ``tab``) and its key press; a renewal of a released
+    # press is ignored, and the jog stops when that tab's live feed drops
+    tab: str | None = Field(None, min_length=1, max_length=64, pattern=r"^[A-Za-z0-9_-]+$")
+    press: StrictInt | None = Field(None, ge=1, le=2**31)
+    seq: StrictInt | None = Field(None, ge=0, le=2**31, description="renewal number within the press")
 
 
 class GotoBody(_Body):
@@ -83,7 +88,7 @@ def jog(body: JogBody, machine: MachineDep) -> dict:
 @router.post("/machine/jog/continuous", name="api_machine_jog_continuous", dependencies=[needs("jog")])
 def jog_continuous(body: ContinuousJogBody, machine: MachineDep) -> dict:
     """Starts a continuous jog that runs until ``/machine/stop``, Reset or a limit/alarm."""
-    return machine.jog_continuous(body.axis, body.direction, body.feed)
+    return machine.jog_continuous(body.axis, body.direction, body.feed, body.tab, body.press)
 
 
 @router.post("/machine/stop", name="api_machine_stop", dependencies=[needs("view")])   # stopping is never locked

@@ -68,6 +68,13 @@ def get_session(session_id: str, workflow: WorkflowDep) -> dict:
     return workflow.get(session_id).to_api()
 
 
+@router.get("/{session_id}/plan", name="api_measure_plan")
+def plan(session_id: str, workflow: WorkflowDep, point: int | None = None) -> dict:
+    """The planned path of a point from where the probe stands, with the start guard's verdict per
+    segment (``clear``, ``collision``, ``limit``, ``unknown``; probing moves ``contact``/``no_switch``)."""
+    return workflow.plan(session_id, point)
+
+
 @router.post("/{session_id}/start", name="api_measure_start", dependencies=[needs("measure")])
 def nc_start(request: Request, session_id: str, workflow: WorkflowDep,
              body: Annotated[StartBody | None, Body()] = None):

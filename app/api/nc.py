@@ -11,7 +11,7 @@ from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictStr
 
 from app.access.deps import measuring_function, needs, require
 from app.deps import NcDep
-from app.services.nc import NcSyntaxInput
+from app.services.nc import NcSyntaxInput, protected_function
 
 router = APIRouter(prefix="/nc", tags=["nc"])
 
@@ -48,10 +48,11 @@ def _syntax(exc: NcSyntaxInput) -> JSONResponse:
 
 
 def authorizer(request: Request):
-    """The check a cycle makes before it writes: the level of who started the program must allow
-    what the measurement writes (a zero offset, tool data, a calibration), as in JOG."""
-    def authorize(category, target) -> None:
-        function = measuring_function(category, target)
+    """The check a program makes before it writes: the level of who started it must allow what a
+    cycle's measurement writes (a zero offset, tool data, a calibration), as in JOG, and the
+    stored data a program assigns (``function``: the EV/MV memories), as the JSON API does."""
+    def authorize(category, target, function: str | None = None) -> None:
+        function = function or measuring_function(category, target)
         if function:
             require(request, function)
     return authorize
@@ -126,9 +127,10 @@ def variables(nc: NcDep, names: Annotated[str, Query(description="comma-separate
 @router.put("/variables/{name}", name="api_nc_variable_put", dependencies=[needs("measure")])
 def put_variable(name: str, body: VariableBody, nc: NcDep, request: Request) -> dict:
     """Write one variable element (``R1``, ``_EV[9]``, ``_TUL``) as a program would; the EV/MV
-    memories need the zero-offset level like ``/api/memories``."""
-    if name.upper().startswith(("_EV[", "_MV[")):
-        require(request, "offsets")
+    memories need the level of ``/api/memories`` (``app.services.nc.PROTECTED``)."""
+    function = protected_function(name)
+    if function:
+        require(request, function)
     return nc.write_variable(name, body.value)
 
 

@@ -192,6 +192,7 @@ class Body:
     kind: str                                     # "part", "ring_gauge", "tool_probe"
     solid: Primitive
     cutouts: list[Primitive] = field(default_factory=list)
+    name: str = ""                                # what the operator reads ("spigot"); default: kind
 
     def sdf(self, p) -> float:
         return max([self.solid.sdf(p)] + [-c.sdf(p) for c in self.cutouts])
@@ -434,14 +435,14 @@ def build_scene(scenario, table_angle: float = 0.0) -> Scene:
                                    [f.size[0] / 2, f.size[1] / 2, half]))
             elif f.type == "spigot":
                 extras.append(Body("part", Cylinder(rot, place([f.center[0], f.center[1], f.height / 2]),
-                                                    f.diameter / 2, f.height / 2)))
+                                                    f.diameter / 2, f.height / 2), name="spigot"))
             elif f.type == "boss":
                 extras.append(Body("part", Box(rot, place([f.center[0], f.center[1], f.height / 2]),
-                                               [f.size[0] / 2, f.size[1] / 2, f.height / 2])))
+                                               [f.size[0] / 2, f.size[1] / 2, f.height / 2]), name="boss"))
             elif f.type == "sphere":
-                extras.append(Body("part", Ball(place(f.center), f.diameter / 2)))
+                extras.append(Body("part", Ball(place(f.center), f.diameter / 2), name="sphere"))
         if base is not None:
-            bodies.extend(Body("part", solid, cutouts) for solid in _base_solids(base, rot, place))
+            bodies.extend(Body("part", solid, cutouts, name="workpiece") for solid in _base_solids(base, rot, place))
         bodies.extend(extras)
     mount = spindle_mount(scenario)
     ring = scenario.ring_gauge
@@ -520,3 +521,29 @@ def tool_probe_cylinder(tool_probe, grow_radius: float = 0.0, grow_down: float =
                         (cz - bottom) / 2)
     return _axial_cylinder(np.asarray(mount, dtype=float), tool_probe.center,
                            tool_probe.disc_diameter / 2 + grow_radius, tool_probe.height + grow_down)
+
+
+def _primitive_data(solid: Primitive, name: str) -> dict:
+    """One primitive as plain data (engine.guard_model reads it): rotation (local -> MCS, rows),
+    centre, and the shape: ``sphere``/``radius``, a circle ``radius`` or a ``polygon`` with its
+    ``half_height`` along local z."""
+    out: dict = {"name": name, "rotation": solid.rotation.tolist(), "centre": solid.centre.tolist()}
+    if isinstance(solid, Ball):
+        out.update(sphere=True, radius=solid.radius)
+    elif isinstance(solid, Cylinder):
+        out.update(radius=solid.radius, half_height=solid.hz)
+    elif isinstance(solid, Box):
+        out.update(polygon=[[-solid.hx, -solid.hy], [solid.hx, -solid.hy], [solid.hx, solid.hy],
+                            [-solid.hx, solid.hy]], half_height=solid.hz)
+    elif isinstance(solid, ConvexPrism):
+        out.update(polygon=[list(p) for p in solid.polygon], half_height=solid.hz)
+    else:                                            # pragma: no cover - every primitive is listed
+        raise TypeError(f"unknown primitive {solid!r}")
+    return out
+
+
+def protection_data(scene: Scene) -> list[dict]:
+    """The scene as the control's protection model (the start guard, issue 24 §1): bodies of a
+    solid minus cut-outs, each named as the operator reads it."""
+    return [{"solid": _primitive_data(body.solid, body.name or body.kind),
+             "cutouts": [_primitive_data(c, "cut-out") for c in body.cutouts]} for body in scene.bodies]

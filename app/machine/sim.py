@@ -59,7 +59,7 @@ from .protocol import (
     add_alarm_once,
 )
 from .scenario import GEOMETRY_AXES, Scenario
-from .scene import Scene, outline
+from .scene import Scene, outline, protection_data
 from .series import cut_part, new_tools, worn
 from .sim_trainer import setup_error as trainer_setup_error
 
@@ -490,6 +490,15 @@ class SimulatedMachine:
         if distance is not None:
             distance = finite(distance, "distance")
         return self.goto(self._kinematics.retract_target(position, distance), None)
+
+    # --- protection model (the start guard, issue 24 §1) ----------------------------------
+    def protection_model(self) -> dict:
+        """The solids and axis limits the control protects (plain data, MCS): this machine's
+        commissioned model of its work space is its scene (the guard computes on its own)."""
+        with self._lock:
+            scene = self._contact.scene
+            limits = {a: [float(lo), float(hi)] for a, (lo, hi) in self._kinematics.limits.items()}
+        return {"bodies": protection_data(scene), "limits": limits}
 
     # --- machine view (SimulatorControl) ---------------------------------------------------
     def scene_geometry(self) -> dict:

@@ -102,6 +102,32 @@ def _close(a: float, b: float) -> bool:
     return a == b or math.isclose(a, b, rel_tol=1e-12, abs_tol=1e-300)
 
 
+#: the operators on two numbers: arithmetic (result checked for size, integers kept), the rest
+#: (comparisons with the control's tolerance, logic, DIV) as they are; which divide by their right side
+_ARITHMETIC: dict[str, Callable[[float, float], float]] = {
+    "+": lambda x, y: x + y, "-": lambda x, y: x - y, "*": lambda x, y: x * y, "/": lambda x, y: x / y,
+    "MOD": math.fmod,
+}
+_LOGIC: dict[str, Callable[[float, float], Value]] = {
+    "DIV": lambda x, y: math.trunc(x / y),
+    "==": _close, "<>": lambda x, y: not _close(x, y),
+    "<": lambda x, y: x < y and not _close(x, y), ">": lambda x, y: x > y and not _close(x, y),
+    "<=": lambda x, y: x < y or _close(x, y), ">=": lambda x, y: x > y or _close(x, y),
+    "AND": lambda x, y: bool(x) and bool(y), "OR": lambda x, y: bool(x) or bool(y),
+    "XOR": lambda x, y: bool(x) != bool(y),
+}
+_ZERO_DIVISION = {"/": "division by zero", "DIV": "division by zero (DIV)", "MOD": "division by zero (MOD)"}
+
+
+def _on_texts(op: str, a: Value, b: Value, pos: n.Pos) -> Value:
+    """``<<`` joins two values as texts; ``==``/``<>`` compare two texts (not a text with a number)."""
+    if op == "<<":
+        return as_text(a) + as_text(b)
+    if not (isinstance(a, str) and isinstance(b, str)):
+        raise EvalError(f"'{op}' compares a text with a number", pos, alarms.NC_VALUE_RANGE)
+    return (a == b) if op == "==" else (a != b)
+
+
 class Evaluator:
     """Evaluates the expressions of one block; writes go to ``pending`` until ``commit()``."""
 
@@ -146,55 +172,21 @@ class Evaluator:
     def _binary(self, e: n.Binary) -> Value:
         a, b = self._eval(e.left), self._eval(e.right)
         op = e.op
-        if op == "<<":
-            return as_text(a) + as_text(b)
-        if op in ("==", "<>") and (isinstance(a, str) or isinstance(b, str)):
-            if not (isinstance(a, str) and isinstance(b, str)):
-                raise EvalError(f"'{op}' compares a text with a number", e.pos, alarms.NC_VALUE_RANGE)
-            return (a == b) if op == "==" else (a != b)
+        if op == "<<" or (op in ("==", "<>") and (isinstance(a, str) or isinstance(b, str))):
+            return _on_texts(op, a, b, e.pos)
         x, y = _num(a, e.pos, op), _num(b, e.pos, op)
-        if op == "+":
-            r = x + y
-        elif op == "-":
-            r = x - y
-        elif op == "*":
-            r = x * y
-        elif op == "/":
-            if y == 0.0:
-                raise EvalError("division by zero", e.pos)
-            r = x / y
-        elif op == "DIV":
-            if y == 0.0:
-                raise EvalError("division by zero (DIV)", e.pos)
-            return math.trunc(x / y)
-        elif op == "MOD":
-            if y == 0.0:
-                raise EvalError("division by zero (MOD)", e.pos)
-            r = math.fmod(x, y)
-        elif op == "==":
-            return _close(x, y)
-        elif op == "<>":
-            return not _close(x, y)
-        elif op == "<":
-            return x < y and not _close(x, y)
-        elif op == ">":
-            return x > y and not _close(x, y)
-        elif op == "<=":
-            return x < y or _close(x, y)
-        elif op == ">=":
-            return x > y or _close(x, y)
-        elif op == "AND":
-            return bool(x) and bool(y)
-        elif op == "OR":
-            return bool(x) or bool(y)
-        elif op == "XOR":
-            return bool(x) != bool(y)
-        else:
+        if y == 0.0 and op in _ZERO_DIVISION:
+            raise EvalError(_ZERO_DIVISION[op], e.pos)
+        if op in _LOGIC:
+            return _LOGIC[op](x, y)
+        arithmetic = _ARITHMETIC.get(op)
+        if arithmetic is None:
             raise EvalError(f"unknown operator {op}", e.pos, alarms.NC_INTERNAL)
+        r = arithmetic(x, y)
         if not math.isfinite(r):
             raise EvalError(f"the result of '{op}' is too large", e.pos)
         if isinstance(a, int) and isinstance(b, int) and op in "+-*" and not isinstance(r, bool):
-            return int(r) if abs(r) < 2**53 else r
+            return int(r) if abs(r) < 2**53 else r          # integers stay integers (INT variables, indices)
         return r
 
     def _function(self, e: n.Func) -> float:

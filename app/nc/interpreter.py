@@ -24,6 +24,7 @@ import threading
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -37,6 +38,7 @@ from .errors import NcAlarm, NcRuntimeError, NcSyntaxError
 from .expressions import FUNCTIONS, EvalError, Evaluator
 from .modal import (
     DISTANCE,
+    FEED_TYPE,
     GEOMETRY_AXES,
     M_END,
     M_END_RESET,
@@ -221,6 +223,73 @@ class CycleContext:
         return NcAlarm(message, self._pos.line, self._pos.column, alarm=definition, block_text=self.block.text)
 
 
+# --- one block on its way: what its words say, and the state after it ------------------------------
+
+@dataclass
+class _Plan:
+    """A block between its phases: the words evaluated (in the order written), then the modal
+    state after the block (``new``) as the checks build it, then what the motion measured."""
+
+    block: n.Block
+    ev: Evaluator
+    before: ModalState
+    new: ModalState = field(init=False)
+    axis_values: dict[str, tuple[n.AxisWord, float]] = field(default_factory=dict)
+    address: dict[str, tuple[n.Address, float]] = field(default_factory=dict)
+    meas: tuple[n.Meas, float] | None = None
+    spos: tuple[n.Spos, float] | None = None
+    call: tuple[n.CycleCall, tuple] | None = None
+    goto: n.Goto | None = None
+    msg: tuple[n.Msg, str | None] | None = None
+    suppress: bool = False
+    tool_change: bool = False
+    edge_word: tuple[n.Address, float] | None = None
+    spindle: tuple[n.MCode, int] | None = None
+    motion_kind: str | None = None
+    measurement: tuple[MeasureResult, Coordinates, int] | None = None
+
+    def __post_init__(self) -> None:
+        self.new = self.before
+        self.gcodes = {g_group(g.number): g for g in self.block.gcodes()}
+        self.mcodes = {m.number: m for m in self.block.words if isinstance(m, n.MCode)}
+
+
+def _eval_define(plan: _Plan, w: n.Define) -> None:
+    for item in w.items:
+        if item.init is not None:
+            plan.ev.fill(item.name, plan.ev.eval(item.init), item.init.pos)
+
+
+def _eval_if_goto(plan: _Plan, w: n.IfGoto) -> None:
+    if _truth(plan.ev.eval(w.condition), w.condition.pos):
+        plan.goto = w.goto
+
+
+def _eval_msg(plan: _Plan, w: n.Msg) -> None:
+    value = None if w.value is None else plan.ev.eval(w.value)
+    plan.msg = (w, None if value is None else _text(value))
+
+
+def _nothing(plan: _Plan, w) -> None:
+    """G and M words are read by the checks from the block itself; STOPRE needs nothing here."""
+
+
+#: evaluation of each kind of word, in the order written (an assignment is seen by later words)
+_EVALUATE: dict[type, Callable[[_Plan, Any], None]] = {
+    n.Assign: lambda plan, w: plan.ev.assign(w),
+    n.Define: _eval_define,
+    n.AxisWord: lambda plan, w: plan.axis_values.__setitem__(w.axis, (w, plan.ev.number(w.value, w.axis))),
+    n.Address: lambda plan, w: plan.address.__setitem__(w.letter, (w, plan.ev.number(w.value, w.letter))),
+    n.Meas: lambda plan, w: setattr(plan, "meas", (w, plan.ev.number(w.value, w.kind))),
+    n.Spos: lambda plan, w: setattr(plan, "spos", (w, plan.ev.number(w.value, "SPOS"))),
+    n.CycleCall: lambda plan, w: setattr(plan, "call", (w, tuple(plan.ev.eval(a) for a in w.args))),
+    n.IfGoto: _eval_if_goto,
+    n.Goto: lambda plan, w: setattr(plan, "goto", w),
+    n.Msg: _eval_msg,
+    n.GCode: _nothing, n.MCode: _nothing, n.Stopre: _nothing,
+}
+
+
 # --- the interpreter ------------------------------------------------------------------------------
 
 _IDLE, _READY, _RUNNING, _STOPPED, _DONE, _ALARM = "idle", "ready", "running", "stopped", "done", "alarm"
@@ -255,7 +324,7 @@ class Interpreter:
         self.runtime = runtime
         self.max_jumps = max_jumps
         self.watchdog_s = watchdog_s
-        self._commands = 0                  # machine commands given (the watchdog's sign of life)
+        self._command_count = 0             # machine commands given (the watchdog's sign of life)
         self.variables = variables if variables is not None else Variables(axes=runtime.axes)
         self.cycles: Mapping[str, CycleHandler] = cycles if cycles is not None else {}
         self._defaults = defaults or ModalState()
@@ -373,6 +442,23 @@ class Interpreter:
 
     # --- execution ---------------------------------------------------------------------------------
     def _go(self, single: bool) -> RunResult:
+        program = self._begin()
+        last: BlockRef | None = None
+        watch = _Watchdog(self)
+        try:
+            while True:
+                result, last = self._next_block(program, watch, single, last)
+                if result is not None:
+                    return result
+        except NcAlarm as alarm:
+            return self._finish(_ALARM, None, BlockRef.of(program.blocks[self._pc]), alarm)
+        except BaseException:
+            with self._lock:
+                self._state = _ALARM
+            raise
+
+    def _begin(self) -> n.Program:
+        """NC Start: the loaded program runs from its current block."""
         with self._lock:
             if self._program is None:
                 raise NcStateError("no program loaded")
@@ -383,43 +469,37 @@ class Interpreter:
                                    "load it again or press Reset")
             self._state = _RUNNING
             self._stop.clear()
-        program = self._program
-        last: BlockRef | None = None
-        watch = _Watchdog(self)
-        try:
-            while True:
-                if self._pc >= len(program.blocks):
-                    return self._finish(_DONE, "end", last)
-                if self._stop.is_set():
-                    return self._finish(_STOPPED, "stop_request", last, next_block=True)
-                block = program.blocks[self._pc]
-                ref = BlockRef.of(block)
-                with self._lock:
-                    self._current = ref
-                if self._on_block is not None:
-                    self._on_block(ref)
-                control = self._execute(block)
-                last = ref
-                if control.kind == "end":
-                    return self._finish(_DONE, control.reason, last)
-                watch.check(block, control)
-                if control.kind == "jump":
-                    assert control.target is not None       # a jump names its block (_execute_block)
-                    self._pc = control.target
-                else:
-                    self._pc += 1
-                if control.kind == "stop":
-                    return self._finish(_STOPPED, control.reason, last, next_block=True)
-                if single:
-                    if self._pc >= len(program.blocks):
-                        return self._finish(_DONE, "end", last)
-                    return self._finish(_STOPPED, "single_block", last, next_block=True)
-        except NcAlarm as alarm:
-            return self._finish(_ALARM, None, BlockRef.of(program.blocks[self._pc]), alarm)
-        except BaseException:
-            with self._lock:
-                self._state = _ALARM
-            raise
+            return self._program
+
+    def _next_block(self, program: n.Program, watch: _Watchdog, single: bool,
+                    last: BlockRef | None) -> tuple[RunResult | None, BlockRef | None]:
+        """Execute the block at ``_pc``: (the run's result if it ends here, the block executed last)."""
+        if self._pc >= len(program.blocks):
+            return self._finish(_DONE, "end", last), last
+        if self._stop.is_set():
+            return self._finish(_STOPPED, "stop_request", last, next_block=True), last
+        block = program.blocks[self._pc]
+        ref = BlockRef.of(block)
+        with self._lock:
+            self._current = ref
+        if self._on_block is not None:
+            self._on_block(ref)
+        control = self._execute(block)
+        if control.kind == "end":
+            return self._finish(_DONE, control.reason, ref), ref
+        watch.check(block, control)
+        if control.kind == "jump":
+            assert control.target is not None       # a jump names its block (_control)
+            self._pc = control.target
+        else:
+            self._pc += 1
+        if control.kind == "stop":
+            return self._finish(_STOPPED, control.reason, ref, next_block=True), ref
+        if single:
+            if self._pc >= len(program.blocks):
+                return self._finish(_DONE, "end", ref), ref
+            return self._finish(_STOPPED, "single_block", ref, next_block=True), ref
+        return None, ref
 
     def _finish(self, state: str, reason: str | None, block: BlockRef | None, alarm: NcAlarm | None = None,
                 next_block: bool = False) -> RunResult:
@@ -460,54 +540,40 @@ class Interpreter:
 
     def _located(self, word, call):
         """Run ``call``; an ``NcRuntimeError`` becomes an alarm located at ``word``."""
-        self._commands += 1
+        self._command_count += 1
         try:
             return call()
         except NcRuntimeError as e:
             raise self._alarm(word, e.alarm or alarms.NC_INTERNAL, e.message) from None
 
+    # --- one block: word groups, each checked, commanded, committed (two phases) ------------------
     def _execute_block(self, block: n.Block) -> _Control:
-        ev = Evaluator(self.variables)
-        before = self._modal
-        gcodes = {g_group(g.number): g for g in block.gcodes()}
-        axis_values: dict[str, tuple[n.AxisWord, float]] = {}
-        address: dict[str, tuple[n.Address, float]] = {}
-        mcodes = {m.number: m for m in block.words if isinstance(m, n.MCode)}
-        meas: tuple[n.Meas, float] | None = None
-        spos: tuple[n.Spos, float] | None = None
-        call: tuple[n.CycleCall, tuple] | None = None
-        goto: n.Goto | None = None
-        msg: tuple[n.Msg, str | None] | None = None
+        """Evaluate the words in the order written, check every word group's part of the state
+        after the block (nothing moves yet), command the machine group by group, then commit."""
+        plan = _Plan(block, Evaluator(self.variables), self._modal)
+        for word in block.words:
+            _EVALUATE.get(type(word), _nothing)(plan, word)
+        plan.new = plan.before
+        for check in self._checks():
+            check(plan)
+        for command in self._commands():
+            command(plan)
+        self._commit(plan)
+        return self._control(plan)
 
-        # --- phase 1: evaluate in the order written (assignments are seen by later words) -----------
-        for w in block.words:
-            if isinstance(w, n.Assign):
-                ev.assign(w)
-            elif isinstance(w, n.Define):
-                for item in w.items:
-                    if item.init is not None:
-                        ev.fill(item.name, ev.eval(item.init), item.init.pos)
-            elif isinstance(w, n.AxisWord):
-                axis_values[w.axis] = (w, ev.number(w.value, w.axis))
-            elif isinstance(w, n.Address):
-                address[w.letter] = (w, ev.number(w.value, w.letter))
-            elif isinstance(w, n.Meas):
-                meas = (w, ev.number(w.value, w.kind))
-            elif isinstance(w, n.Spos):
-                spos = (w, ev.number(w.value, "SPOS"))
-            elif isinstance(w, n.CycleCall):
-                call = (w, tuple(ev.eval(a) for a in w.args))
-            elif isinstance(w, n.IfGoto):
-                if _truth(ev.eval(w.condition), w.condition.pos):
-                    goto = w.goto
-            elif isinstance(w, n.Goto):
-                goto = w
-            elif isinstance(w, n.Msg):
-                value = None if w.value is None else ev.eval(w.value)
-                msg = (w, None if value is None else _text(value))
+    def _checks(self) -> tuple[Callable[[_Plan], None], ...]:
+        """The state after the block, group by group, checked before anything moves."""
+        return (self._check_modal_groups, self._check_feed, self._check_spindle_speed, self._check_tool,
+                self._check_spindle, self._check_measuring_offsets, self._check_meas, self._check_motion_kind)
 
-        # --- phase 2: the state after the block, checked before anything moves ---------------------
-        new = before
+    def _commands(self) -> tuple[Callable[[_Plan], None], ...]:
+        """What the machine does, in the 840D's order: tool, spindle, motion."""
+        return (self._command_tool, self._command_spos, self._command_spindle, self._command_motion)
+
+    # --- checks (phase 1) --------------------------------------------------------------------------
+    def _check_modal_groups(self, plan: _Plan) -> None:
+        gcodes = plan.gcodes
+        new = plan.new
         if MOTION in gcodes:
             new = new.replace(motion=gcodes[MOTION].name)
         if PLANE in gcodes:
@@ -516,120 +582,152 @@ class Interpreter:
             new = new.replace(distance=gcodes[DISTANCE].name)
         if UNITS in gcodes:
             new = new.replace(units=gcodes[UNITS].name)
+        if FEED_TYPE in gcodes:
+            new = new.replace(feed_type=gcodes[FEED_TYPE].name)
         if OFFSET in gcodes:
             new = new.replace(offset=gcodes[OFFSET].name)
-            self._located(gcodes[OFFSET], lambda: self.runtime.offset_chain(new.offset))   # it must exist
-        suppress = 53 in {g.number for g in block.gcodes()}
-        measuring = gcodes.get(MEASURING)
-        if "F" in address:
-            word, value = address["F"]
+            offset = new.offset
+            self._located(gcodes[OFFSET], lambda: self.runtime.offset_chain(offset))   # it must exist
+        plan.new = new
+        plan.suppress = 53 in {g.number for g in plan.block.gcodes()}
+
+    def _check_feed(self, plan: _Plan) -> None:
+        if "F" in plan.address:
+            word, value = plan.address["F"]
             if not value > 0.0:
                 raise self._alarm(word, alarms.NC_FEED_MISSING, f"F{value:g}: the feed must be greater than 0")
-            new = new.replace(feed=new.feed_to_mm(value))
-        if "S" in address:
-            word, value = address["S"]
+            plan.new = plan.new.replace(feed=plan.new.feed_to_mm(value))
+
+    def _check_spindle_speed(self, plan: _Plan) -> None:
+        if "S" in plan.address:
+            word, value = plan.address["S"]
             if value < 0.0:
                 raise self._alarm(word, alarms.NC_VALUE_RANGE, f"S{value:g}: the spindle speed cannot be negative")
-            new = new.replace(spindle_speed=value)
-        if "T" in address:
-            word, value = address["T"]
+            plan.new = plan.new.replace(spindle_speed=value)
+
+    def _check_tool(self, plan: _Plan) -> None:
+        """T preselects, M6 changes, D selects the edge; the tool data must exist before anything moves."""
+        if "T" in plan.address:
+            word, value = plan.address["T"]
             t = _whole(value, word, "T", self)
-            new = new.replace(preselected=t if t > 0 else None)
-        tool_change = M_TOOL_CHANGE in mcodes
-        edge_word = address.get("D")
-        if tool_change:
-            edge = 1 if new.preselected is not None else 0
-            new = new.replace(tool=new.preselected, edge=edge)
-        if edge_word is not None:
-            word, value = edge_word
+            plan.new = plan.new.replace(preselected=t if t > 0 else None)
+        plan.tool_change = M_TOOL_CHANGE in plan.mcodes
+        plan.edge_word = plan.address.get("D")
+        new = plan.new
+        if plan.tool_change:
+            new = new.replace(tool=new.preselected, edge=1 if new.preselected is not None else 0)
+        if plan.edge_word is not None:
+            word, value = plan.edge_word
             d = _whole(value, word, "D", self)
             if d > 0 and new.tool is None:
                 raise self._alarm(word, alarms.NC_D_NUMBER, f"D{d}: there is no tool in the spindle")
             new = new.replace(edge=d)
-        if new.tool != before.tool or new.edge != before.edge:
-            # the tool data must exist before anything is commanded
-            self._located(edge_word[0] if edge_word else mcodes[M_TOOL_CHANGE],
-                          lambda: self.runtime.tool_length(new.tool, new.edge))
-        spindle = None
+        plan.new = new
+        if new.tool != plan.before.tool or new.edge != plan.before.edge:
+            where = plan.edge_word[0] if plan.edge_word else plan.mcodes[M_TOOL_CHANGE]
+            self._located(where, lambda: self.runtime.tool_length(new.tool, new.edge))
+
+    def _check_spindle(self, plan: _Plan) -> None:
         for number, direction in M_SPINDLE.items():
-            if number in mcodes:
-                spindle = (mcodes[number], direction)
-        if spindle is not None:
-            new = new.replace(spindle_direction=spindle[1])
-            if spindle[1] != 0 and not new.spindle_speed > 0.0:
-                raise self._alarm(spindle[0], alarms.NC_VALUE_RANGE,
-                                  f"M{spindle[0].number}: program a spindle speed S greater than 0")
-        if spos is not None:
-            if not math.isfinite(spos[1]):
-                raise self._alarm(spos[0], alarms.NC_VALUE_RANGE, "SPOS: the angle is not a number")
-            new = new.replace(spindle_direction=0)
+            if number in plan.mcodes:
+                plan.spindle = (plan.mcodes[number], direction)
+        if plan.spindle is not None:
+            word, direction = plan.spindle
+            plan.new = plan.new.replace(spindle_direction=direction)
+            if direction != 0 and not plan.new.spindle_speed > 0.0:
+                raise self._alarm(word, alarms.NC_VALUE_RANGE, f"M{word.number}: program a spindle speed S greater than 0")
+        if plan.spos is not None:
+            if not math.isfinite(plan.spos[1]):
+                raise self._alarm(plan.spos[0], alarms.NC_VALUE_RANGE, "SPOS: the angle is not a number")
+            plan.new = plan.new.replace(spindle_direction=0)
 
+    def _check_measuring_offsets(self, plan: _Plan) -> None:
+        """G101/G102 include or remove measuring offsets: their axis words are factors, no motion."""
+        measuring = plan.gcodes.get(MEASURING)
         if measuring is not None and measuring.number in (101, 102):
-            new = new.replace(measuring=self._measuring_offsets(measuring, new.measuring, axis_values))
-            axis_values = {}
+            plan.new = plan.new.replace(measuring=self._measuring_offsets(measuring, plan.new.measuring,
+                                                                          plan.axis_values))
+            plan.axis_values = {}
 
-        if meas is not None:
-            meas_word, value = meas
-            if value not in (1, 2):
-                hint = " (the falling edge, MEAS=-n, is not supported)" if value in (-1, -2) else ""
-                raise self._alarm(meas_word, alarms.NC_VALUE_RANGE,
-                                  f"{meas_word.kind}={value:g}: the measuring input must be 1 or 2{hint}")
-            if new.motion == "G0":
-                raise self._alarm(meas_word, alarms.NC_SYNTAX,
-                                  f"{meas_word.kind} is a measuring move at feed: G0 is active, program G1")
+    def _check_meas(self, plan: _Plan) -> None:
+        if plan.meas is None:
+            return
+        word, value = plan.meas
+        if value not in (1, 2):
+            hint = " (the falling edge, MEAS=-n, is not supported)" if value in (-1, -2) else ""
+            raise self._alarm(word, alarms.NC_VALUE_RANGE,
+                              f"{word.kind}={value:g}: the measuring input must be 1 or 2{hint}")
+        if plan.new.motion == "G0":
+            raise self._alarm(word, alarms.NC_SYNTAX,
+                              f"{word.kind} is a measuring move at feed: G0 is active, program G1")
 
-        motion_kind = None
+    def _check_motion_kind(self, plan: _Plan) -> None:
+        measuring = plan.gcodes.get(MEASURING)
         if measuring is not None and measuring.number == 100:
-            motion_kind = "G100"
-        elif axis_values:
-            motion_kind = "MEAS" if meas is not None else new.motion
-        if motion_kind in ("G1", "MEAS", "G100") and new.feed is None:
-            first = next(iter(axis_values.values()))[0]
-            raise self._alarm(first, alarms.NC_FEED_MISSING,
-                              f"{'G100' if motion_kind == 'G100' else 'G1'}: no feed programmed; program F")
+            plan.motion_kind = "G100"
+        elif plan.axis_values:
+            plan.motion_kind = "MEAS" if plan.meas is not None else plan.new.motion
+        if plan.motion_kind in ("G1", "MEAS", "G100") and plan.new.path_feed() is None:
+            first = next(iter(plan.axis_values.values()))[0]
+            what = "G100" if plan.motion_kind == "G100" else "G1"
+            if plan.new.feed is not None:           # G95 with the spindle standing
+                raise self._alarm(first, alarms.NC_FEED_MISSING,
+                                  f"{what}: G95 is a feed per revolution and the spindle stands: program M3/M4 "
+                                  "with S, or G94")
+            raise self._alarm(first, alarms.NC_FEED_MISSING, f"{what}: no feed programmed; program F")
 
-        # --- phase 3: command the machine ----------------------------------------------------------
-        if tool_change:
-            self._located(mcodes[M_TOOL_CHANGE], lambda: self.runtime.change_tool(new.tool, new.edge))
+    # --- commands (phase 2): physical facts that happened stay ---------------------------------------
+    def _command_tool(self, plan: _Plan) -> None:
+        new = plan.new
+        if plan.tool_change:
+            self._located(plan.mcodes[M_TOOL_CHANGE], lambda: self.runtime.change_tool(new.tool, new.edge))
             self._modal = self._modal.replace(tool=new.tool, edge=new.edge, preselected=new.preselected)
-        elif edge_word is not None and new.edge != before.edge:
-            self._located(edge_word[0], lambda: self.runtime.select_edge(new.edge))
+        elif plan.edge_word is not None and new.edge != plan.before.edge:
+            self._located(plan.edge_word[0], lambda: self.runtime.select_edge(new.edge))
             self._modal = self._modal.replace(edge=new.edge)
+
+    def _command_spos(self, plan: _Plan) -> None:
+        spos = plan.spos
         if spos is not None:
             self._located(spos[0], lambda: self.runtime.spindle_position(spos[1]))
             self._modal = self._modal.replace(spindle_direction=0)
-        if spindle is not None or ("S" in address and new.spindle_direction != 0):
-            spindle_word = spindle[0] if spindle is not None else address["S"][0]
-            self._located(spindle_word, lambda: self.runtime.spindle(new.spindle_direction, new.spindle_speed))
-            self._modal = self._modal.replace(spindle_direction=new.spindle_direction,
-                                              spindle_speed=new.spindle_speed)
 
-        measurement: tuple[MeasureResult, Coordinates, int] | None = None
-        if motion_kind == "G100":
-            new = new.replace(measuring=self._g100(ev, new, axis_values))
-        elif motion_kind is not None:
-            measurement = self._motion(new, suppress, axis_values, meas, motion_kind)
+    def _command_spindle(self, plan: _Plan) -> None:
+        new = plan.new
+        if plan.spindle is None and not ("S" in plan.address and new.spindle_direction != 0):
+            return
+        word = plan.spindle[0] if plan.spindle is not None else plan.address["S"][0]
+        self._located(word, lambda: self.runtime.spindle(new.spindle_direction, new.spindle_speed))
+        self._modal = self._modal.replace(spindle_direction=new.spindle_direction, spindle_speed=new.spindle_speed)
 
-        # --- phase 4: commit ------------------------------------------------------------------------
-        if new.offset != before.offset:
-            self._located(gcodes.get(OFFSET, block), lambda: self.runtime.activate_offset(new.offset))
-        ev.commit()
-        if measurement is not None:
-            self._store_measurement(*measurement)
+    def _command_motion(self, plan: _Plan) -> None:
+        if plan.motion_kind == "G100":
+            plan.new = plan.new.replace(measuring=self._g100(plan.ev, plan.new, plan.axis_values))
+        elif plan.motion_kind is not None:
+            plan.measurement = self._motion(plan.new, plan.suppress, plan.axis_values, plan.meas, plan.motion_kind)
+
+    # --- commit, then the cycle and the program flow ---------------------------------------------------
+    def _commit(self, plan: _Plan) -> None:
+        new = plan.new
+        if new.offset != plan.before.offset:
+            self._located(plan.gcodes.get(OFFSET, plan.block), lambda: self.runtime.activate_offset(new.offset))
+        plan.ev.commit()
+        if plan.measurement is not None:
+            self._store_measurement(*plan.measurement)
         self._modal = new
-        if msg is not None:
-            self._message = msg[1]
+        if plan.msg is not None:
+            self._message = plan.msg[1]
+        if plan.call is not None:
+            self._call_cycle(plan.block, *plan.call)
 
-        if call is not None:
-            self._call_cycle(block, *call)
-
-        # --- program control ------------------------------------------------------------------------
+    def _control(self, plan: _Plan) -> _Control:
+        mcodes, goto = plan.mcodes, plan.goto
         for number, reason in ((M_END_RESET, "M30"), (M_END, "M2"), (M_SUB_END, "M17")):
             if number in mcodes:
                 return _Control("end", reason=reason)
         if goto is not None:
             assert self._program is not None                # a block runs within its loaded program
-            target = find_jump(self._program, block.index, goto)
+            target = find_jump(self._program, plan.block.index, goto)
             if target is None:  # checked at load; a program given as nodes may still lack it
                 raise self._alarm(goto, alarms.NC_JUMP_TARGET, f"{goto.direction} {goto.target}: jump target not found")
             if M_STOP in mcodes:
@@ -652,30 +750,14 @@ class Interpreter:
         coords = self._located(first_word, lambda: self._coordinates(new, suppress))
         position = self._located(first_word, self.runtime.position)
         offsets = _EMPTY_OFFSETS if suppress else new.measuring
-        shift = np.array([offsets.offset(a) for a in GEOMETRY_AXES])
-        target: dict[str, float] = {}
-        geometry = [a for a in axis_values if a in GEOMETRY_AXES]
-        if geometry:
-            now_prog = coords.tip_wcs(position) - shift
-            prog = now_prog.copy()
-            for a in geometry:
-                i = GEOMETRY_AXES.index(a)
-                value = new.length_to_mm(axis_values[a][1])
-                prog[i] = value if new.distance == "G90" else now_prog[i] + value
-            axes = coords.axes_for(prog + shift)
-            target.update({a: float(v) for a, v in zip(GEOMETRY_AXES, axes, strict=True)})
-        for a, (_word, value) in axis_values.items():
-            if a in GEOMETRY_AXES:
-                continue
-            now = coords.rotary_wcs(a, position[a])
-            target[a] = coords.rotary_mcs(a, value if new.distance == "G90" else now + value)
+        target = _target_mcs(coords, position, new, axis_values, offsets)
         if not all(math.isfinite(v) for v in target.values()):
             raise self._alarm(first_word, alarms.NC_VALUE_RANGE, "the target position is not a finite number")
         if kind == "G0":
             self._located(first_word, lambda: self.runtime.move(target, None))
             return None
         if kind == "G1":
-            self._located(first_word, lambda: self.runtime.move(target, new.feed))
+            self._located(first_word, lambda: self.runtime.move(target, new.path_feed()))
             return None
         word, value = meas
         if any(a not in GEOMETRY_AXES for a in axis_values):
@@ -683,7 +765,7 @@ class Interpreter:
         if all(abs(target[a] - float(position[a])) < 1e-9 for a in GEOMETRY_AXES):
             raise self._alarm(word, alarms.NO_MEASURING_PATH,
                               f"{word.kind}: the probe is already at the programmed end point")
-        feed = new.feed
+        feed = new.path_feed()
         assert feed is not None                         # _execute_block refused MEAS/MEAW without F
         result = self._located(first_word, lambda: self.runtime.measure(target, feed, word.kind == "MEAS"))
         # $AA_MW is given in the active WCS, also when G53 suppressed the frames of this block
@@ -729,7 +811,7 @@ class Interpreter:
         end[i] = target + math.copysign(fa, path)
         axes = coords.axes_for(end)
         mcs = {a: float(v) for a, v in zip(GEOMETRY_AXES, axes, strict=True)}
-        feed = new.feed
+        feed = new.path_feed()
         assert feed is not None                         # _execute_block refused G100 without F
         result = self._located(word, lambda: self.runtime.measure(mcs, feed, True))
         if not result.triggered:
@@ -852,42 +934,31 @@ class Interpreter:
                 self._check_expr(a)
 
     def _check_var(self, var: n.Var, write: bool) -> None:
-        v = self.variables
-        if not v.has(var.name):
-            hint = ""
-            if var.name in GEOMETRY_AXES or len(var.name) == 1:
-                hint = " (an axis is only an index here, e.g. $AA_MM[X])"
-            raise NcSyntaxError(f"{var.name} is not a known variable{hint}; define local variables with DEF",
-                                var.pos.line, var.pos.column, alarm=alarms.NC_NAME_UNKNOWN)
-        d = v.definition(var.name)
+        d = self._known_var(var)
         if write and not d.writable:
             raise NcSyntaxError(f"{d.name} is written by the control only", var.pos.line, var.pos.column,
                                 alarm=alarms.NC_WRITE_PROTECTED)
-        if d.is_array and not var.indices:
-            raise NcSyntaxError(f"{d.name} is an array: name the element, e.g. {d.name}[0]",
-                                var.pos.line, var.pos.column, alarm=alarms.NC_ARRAY_INDEX)
-        if not d.is_array and var.indices:
-            raise NcSyntaxError(f"{d.name} is not an array and takes no index", var.pos.line, var.pos.column,
-                                alarm=alarms.NC_ARRAY_INDEX)
+        _check_indexing(d, var)
         if d.axis_indexed:
-            if len(var.indices) != 1 or not (isinstance(var.indices[0], n.Var) and not var.indices[0].indices
-                                             and var.indices[0].name in GEOMETRY_AXES + ("A", "B", "C")):
-                raise NcSyntaxError(f"{d.name} takes an axis name as index, e.g. {d.name}[X]",
-                                    var.pos.line, var.pos.column, alarm=alarms.NC_ARRAY_INDEX)
             return
-        if d.shape and len(var.indices) != len(d.shape):
-            raise NcSyntaxError(f"{d.name} needs {len(d.shape)} ind{'ex' if len(d.shape) == 1 else 'ices'}",
-                                var.pos.line, var.pos.column, alarm=alarms.NC_ARRAY_INDEX)
-        constant = []
         for i in var.indices:
             self._check_expr(i)
-            constant.append(i.value if isinstance(i, n.Num) else None)
+        constant = [i.value if isinstance(i, n.Num) else None for i in var.indices]
         if constant and all(c is not None for c in constant):
             try:
                 d.key(tuple(constant))
             except VariableError as e:
                 where = var.indices[0].pos
                 raise NcSyntaxError(e.message, where.line, where.column, alarm=e.alarm) from None
+
+    def _known_var(self, var: n.Var) -> VarDef:
+        if not self.variables.has(var.name):
+            hint = ""
+            if var.name in GEOMETRY_AXES or len(var.name) == 1:
+                hint = " (an axis is only an index here, e.g. $AA_MM[X])"
+            raise NcSyntaxError(f"{var.name} is not a known variable{hint}; define local variables with DEF",
+                                var.pos.line, var.pos.column, alarm=alarms.NC_NAME_UNKNOWN)
+        return self.variables.definition(var.name)
 
 
 # --- helpers -----------------------------------------------------------------------------------------
@@ -899,7 +970,7 @@ class _Watchdog:
     def __init__(self, interp: Interpreter):
         self._interp = interp
         self._jumps = 0
-        self._commands = interp._commands
+        self._commands = interp._command_count
         self._since = time.monotonic()
 
     def check(self, block: n.Block, control: _Control) -> None:
@@ -911,8 +982,8 @@ class _Watchdog:
                               "(check its condition)", block.line, block.pos.column, alarm=alarms.NC_RUNAWAY,
                               block_text=block.text)
         now = time.monotonic()
-        if interp._commands != self._commands:
-            self._commands, self._since = interp._commands, now
+        if interp._command_count != self._commands:
+            self._commands, self._since = interp._command_count, now
         elif now - self._since > interp.watchdog_s:
             raise NcAlarm(f"the program computed for {interp.watchdog_s:g} s without moving: watchdog",
                           block.line, block.pos.column, alarm=alarms.NC_RUNAWAY, block_text=block.text)
@@ -949,6 +1020,48 @@ def _local_definitions(program: n.Program, variables: Variables) -> list[VarDef]
                 default = "" if w.type == "STRING" else 0
                 out.append(VarDef(item.name, w.type, item.dims, default, length=w.length, scope="LUD"))
     return out
+
+
+def _target_mcs(coords: Coordinates, position: Mapping[str, float], new: ModalState, axis_values,
+                offsets: MeasuringOffsets) -> dict[str, float]:
+    """The MCS axis targets of a block's axis words: geometry axes through the frame and the tool
+    length (measuring offsets shift the programmed point), rotary axes by their frame offset;
+    G90 absolute, G91 from where the tool tip is."""
+    shift = np.array([offsets.offset(a) for a in GEOMETRY_AXES])
+    target: dict[str, float] = {}
+    geometry = [a for a in axis_values if a in GEOMETRY_AXES]
+    if geometry:
+        now_prog = coords.tip_wcs(position) - shift
+        prog = now_prog.copy()
+        for a in geometry:
+            i = GEOMETRY_AXES.index(a)
+            value = new.length_to_mm(axis_values[a][1])
+            prog[i] = value if new.distance == "G90" else now_prog[i] + value
+        axes = coords.axes_for(prog + shift)
+        target.update({a: float(v) for a, v in zip(GEOMETRY_AXES, axes, strict=True)})
+    for a, (_word, value) in axis_values.items():
+        if a not in GEOMETRY_AXES:
+            now = coords.rotary_wcs(a, position[a])
+            target[a] = coords.rotary_mcs(a, value if new.distance == "G90" else now + value)
+    return target
+
+
+def _check_indexing(d: VarDef, var: n.Var) -> None:
+    """An array is named with its indices (an axis name where it is indexed by axes), a scalar without."""
+    def refuse(message: str) -> NcSyntaxError:
+        return NcSyntaxError(message, var.pos.line, var.pos.column, alarm=alarms.NC_ARRAY_INDEX)
+
+    if d.is_array and not var.indices:
+        raise refuse(f"{d.name} is an array: name the element, e.g. {d.name}[0]")
+    if not d.is_array and var.indices:
+        raise refuse(f"{d.name} is not an array and takes no index")
+    if d.axis_indexed:
+        index = var.indices[0] if len(var.indices) == 1 else None
+        if not (isinstance(index, n.Var) and not index.indices and index.name in GEOMETRY_AXES + ("A", "B", "C")):
+            raise refuse(f"{d.name} takes an axis name as index, e.g. {d.name}[X]")
+        return
+    if d.shape and len(var.indices) != len(d.shape):
+        raise refuse(f"{d.name} needs {len(d.shape)} ind{'ex' if len(d.shape) == 1 else 'ices'}")
 
 
 def _truth(value, pos) -> bool:

@@ -25,6 +25,7 @@ OFFSET = "offset"             # G500 G54..G57 G505..G599 [group 8]
 FRAME_SUPPRESS = "suppress"   # G53, non-modal          [group 9]
 UNITS = "units"               # G70 G71 G700 G710       [group 13]
 DISTANCE = "distance"         # G90 G91                 [group 14]
+FEED_TYPE = "feed_type"       # G94 mm/min, G95 mm/rev  [group 15]
 MEASURING = "measuring"       # G100 G101 G102, non-modal (seed 003; another control's functions)
 
 _FIXED_GROUPS = {
@@ -34,6 +35,7 @@ _FIXED_GROUPS = {
     54: OFFSET, 55: OFFSET, 56: OFFSET, 57: OFFSET, 500: OFFSET,
     70: UNITS, 71: UNITS, 700: UNITS, 710: UNITS,
     90: DISTANCE, 91: DISTANCE,
+    94: FEED_TYPE, 95: FEED_TYPE,
     100: MEASURING, 101: MEASURING, 102: MEASURING,
 }
 
@@ -85,7 +87,8 @@ class ModalState:
     distance: str = "G90"
     units: str = "G71"
     offset: str = "G500"
-    feed: float | None = None
+    feed: float | None = None             # as programmed: mm/min (G94) or mm/rev (G95)
+    feed_type: str = "G94"
     spindle_direction: int = 0            # +1 M3, -1 M4, 0 M5
     spindle_speed: float = 0.0
     tool: int | None = None
@@ -106,6 +109,14 @@ class ModalState:
         """Feeds in inch/min: only G700 (840D: G70 converts geometry, G700 also technology data)."""
         return self.units == "G700"
 
+    def path_feed(self) -> float | None:
+        """The path feed in mm/min: F itself (G94), or F times the spindle speed (G95, feed per
+        revolution: None while the spindle stands)."""
+        if self.feed is None or self.feed_type == "G94":
+            return self.feed
+        turning = self.spindle_direction != 0 and self.spindle_speed > 0.0
+        return self.feed * self.spindle_speed if turning else None
+
     def length_to_mm(self, value: float) -> float:
         return value * INCH if self.inch else value
 
@@ -116,7 +127,7 @@ class ModalState:
         """JSON-ready, for the screens and the API."""
         return {
             "motion": self.motion, "plane": self.plane, "distance": self.distance,
-            "units": self.units, "offset": self.offset, "feed": self.feed,
+            "units": self.units, "offset": self.offset, "feed": self.feed, "feed_type": self.feed_type,
             "spindle": {1: "M3", -1: "M4", 0: "M5"}[self.spindle_direction],
             "spindle_speed": self.spindle_speed, "tool": self.tool, "edge": self.edge,
             "preselected": self.preselected, "measuring_offsets": self.measuring.to_dict(),

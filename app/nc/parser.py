@@ -11,8 +11,10 @@ cycles are checked later against the variable store and the cycle registry
 from __future__ import annotations
 
 from bisect import bisect_left, bisect_right
+from collections.abc import Callable
 from functools import lru_cache
 from importlib import resources
+from typing import Any
 
 from lark import Lark, Token, Transformer, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
@@ -172,6 +174,11 @@ class _ToNodes(Transformer):
         if name in AXIS_LETTERS or name in ("F", "S", "T", "D", "SPOS", "MEAS", "MEAW"):
             raise NcSyntaxError(f"{name} needs a value (e.g. {name}10 or {name}=R1)"
                                 if len(name) == 1 else f"{name} needs a value: {name}=...", *_lc(pos))
+        if name == "SUPA":
+            # SUPA suppresses the frames like G53 and also handwheel offsets, external zero offsets
+            # and PRESET (840D Fundamentals, "Frame suppression"): this control has none of those,
+            # so SUPA is G53 here (manual listings §6: N30 SUPA G0 Z100)
+            return n.GCode(53, pos)
         if name in _STRUCTURED:
             raise NcSyntaxError(f"{name}: structured control statements are not part of this control's "
                                 f"language (use IF ... GOTOF/GOTOB with labels)", *_lc(pos))
@@ -356,30 +363,37 @@ def _hint(expected: set[str]) -> str:
     return ": expected " + (", ".join(words[:-1]) + " or " + words[-1] if len(words) > 1 else words[0])
 
 
+_BLOCK_SKIP = ": block skip (/) is not part of this control's language"
+
+
+def _token_message(e: UnexpectedToken, line: int) -> str:
+    prev = _last_token(getattr(getattr(e, "state", None), "value_stack", None))
+    if prev is None and e.token_history:
+        prev = e.token_history[-1]
+    tok = e.token
+    after = _after(prev, line)
+    message = f"the block ends too early{after}" if tok.type == "_NL" else f"unexpected {_describe(tok)}{after}"
+    if tok.value == "/" and after == " at the start of the block":
+        return message + _BLOCK_SKIP
+    return message + _hint(set(e.expected or ()))
+
+
+def _character_message(e: UnexpectedCharacters, line: int) -> str:
+    prev = e.token_history[-1] if getattr(e, "token_history", None) else None
+    message = f"unexpected character '{e.char}'{_after(prev, line)}"
+    if e.char == "/" and (prev is None or prev.line != line):
+        message += _BLOCK_SKIP
+    return message
+
+
 def _syntax_error(e: UnexpectedInput, lines: list[str]) -> NcSyntaxError:
     line = getattr(e, "line", None) or 1
     column = getattr(e, "column", None) or 1
     text = lines[line - 1] if 0 < line <= len(lines) else None
     if isinstance(e, UnexpectedToken):
-        stack = getattr(getattr(e, "state", None), "value_stack", None)
-        prev = _last_token(stack)
-        if prev is None and e.token_history:
-            prev = e.token_history[-1]
-        tok = e.token
-        if tok.type == "_NL":
-            message = f"the block ends too early{_after(prev, line)}"
-        else:
-            message = f"unexpected {_describe(tok)}{_after(prev, line)}"
-        if tok.value == "/" and _after(prev, line) == " at the start of the block":
-            message += ": block skip (/) is not part of this control's language"
-        else:
-            message += _hint(set(e.expected or ()))
+        message = _token_message(e, line)
     elif isinstance(e, UnexpectedCharacters):
-        prev = e.token_history[-1] if getattr(e, "token_history", None) else None
-        char = e.char
-        message = f"unexpected character '{char}'{_after(prev, line)}"
-        if char == "/" and (prev is None or prev.line != line):
-            message += ": block skip (/) is not part of this control's language"
+        message = _character_message(e, line)
     elif isinstance(e, UnexpectedEOF):
         message = "the program ends too early"
     else:  # pragma: no cover - lark has no other kinds
@@ -478,137 +492,183 @@ def _assemble(raw_blocks, source: str, lines: list[str], name: str) -> n.Program
     seen_instruction = False
     for kind, items in raw_blocks:
         if kind == "HEADER":
-            text = lines[items.line - 1].strip()
             if blocks or header is not None:
                 raise NcSyntaxError("the program name line (%...) must be the first line", items.line, items.column,
-                                    block_text=text)
+                                    block_text=lines[items.line - 1].strip())
             header = items.value
             continue
-        line, column = _block_start(items)
-        text = lines[line - 1].strip()
-        number = None
-        label = None
-        words: list = []
-        for child in items:
-            if child is None:
-                continue
-            if isinstance(child, Token) and child.type == "BLOCKNO":
-                number = int(child.value[1:])
-            elif isinstance(child, tuple) and child[0] == "LABEL":
-                tok = child[1]
-                label = tok.value.upper()
-                if label in labels:
-                    raise NcSyntaxError(f"label {label} is defined twice", tok.line, tok.column, block_text=text)
-                labels[label] = len(blocks)
-            else:
-                words.extend(child)
-        block = n.Block(len(blocks), line, text, number, label, tuple(words), n.Pos(line, column))
-        try:
-            _check_block(block)
-        except NcSyntaxError as err:
-            err.block_text = text
-            raise
-        is_def = any(isinstance(w, n.Define) for w in words)
+        block = _block(items, len(blocks), lines, labels)
+        is_def = any(isinstance(w, n.Define) for w in block.words)
         if is_def and seen_instruction:
-            raise NcSyntaxError("DEF must come before the first instruction of the program", line,
-                                words[0].pos.column, block_text=text)
-        if words and not is_def:
-            seen_instruction = True
+            raise NcSyntaxError("DEF must come before the first instruction of the program", block.line,
+                                block.words[0].pos.column, block_text=block.text)
+        seen_instruction = seen_instruction or bool(block.words and not is_def)
         blocks.append(block)
     program = n.Program(name, source, tuple(blocks), header, labels, jump_targets(blocks))
     _check_jumps(program)
     return program
 
 
+def _block(items, index: int, lines: list[str], labels: dict[str, int]) -> n.Block:
+    """One block from the parser's items (N number, label, words), checked; its label recorded."""
+    line, column = _block_start(items)
+    text = lines[line - 1].strip()
+    number = None
+    label = None
+    words: list = []
+    for child in items:
+        if isinstance(child, Token) and child.type == "BLOCKNO":
+            number = int(child.value[1:])
+        elif isinstance(child, tuple) and child[0] == "LABEL":
+            tok = child[1]
+            label = tok.value.upper()
+            if label in labels:
+                raise NcSyntaxError(f"label {label} is defined twice", tok.line, tok.column, block_text=text)
+            labels[label] = index
+        elif child is not None:
+            words.extend(child)
+    block = n.Block(index, line, text, number, label, tuple(words), n.Pos(line, column))
+    try:
+        _check_block(block)
+    except NcSyntaxError as err:
+        err.block_text = text
+        raise
+    return block
+
+
 def _err(word, message: str, **kw) -> NcSyntaxError:
     return NcSyntaxError(message, word.pos.line, word.pos.column, **kw)
 
 
-def _check_block(block: n.Block) -> None:
-    """Words that may not stand together in one block (independent of the configuration)."""
-    groups: dict[str, n.GCode] = {}
-    for g in block.gcodes():
+class _Words:
+    """One block's words sorted for the checks: G functions by group, M functions, axes, MEAS."""
+
+    def __init__(self, block: n.Block):
+        self.block = block
+        self.groups: dict[str, n.GCode] = {}
+        self.ms = [w for w in block.words if isinstance(w, n.MCode)]
+        self.axes = [w for w in block.words if isinstance(w, n.AxisWord)]
+        self.meas = next((w for w in block.words if isinstance(w, n.Meas)), None)
+
+
+def _check_g_groups(words: _Words) -> None:
+    """Every G function exists, and one per group."""
+    for g in words.block.gcodes():
         group = g_group(g.number)
         if group is None:
             hint = " (circles G2/G3 are not part of this control's language)" if g.number in (2, 3) else ""
             raise _err(g, f"G{g.number} is not a G function of this control{hint}",
                        alarm=alarms.NC_G_FUNCTION_UNKNOWN)
-        if group in groups:
-            raise _err(g, f"G{g.number} and G{groups[group].number} exclude each other in one block")
-        groups[group] = g
-    for m in (w for w in block.words if isinstance(w, n.MCode)):
+        if group in words.groups:
+            raise _err(g, f"G{g.number} and G{words.groups[group].number} exclude each other in one block")
+        words.groups[group] = g
+
+
+def _check_m_functions(words: _Words) -> None:
+    """Every M function exists; one of the spindle group (M3 M4 M5), one program end (M0 M2 M17 M30)."""
+    for m in words.ms:
         if m.number not in KNOWN_M:
             raise _err(m, f"M{m.number} is not an M function of this control (M0 M2 M3 M4 M5 M6 M17 M30)")
-    ms = [w for w in block.words if isinstance(w, n.MCode)]
-    spindle = [m for m in ms if m.number in (3, 4, 5)]
-    if len(spindle) > 1:
-        raise _err(spindle[1], f"M{spindle[1].number} and M{spindle[0].number} exclude each other in one block")
-    ends = [m for m in ms if m.number in (0, 2, 17, 30)]
-    if len(ends) > 1:
-        raise _err(ends[1], f"M{ends[1].number} and M{ends[0].number} exclude each other in one block")
-    seen: dict[str, object] = {}
-    for w in block.words:
-        key = None
-        if isinstance(w, n.AxisWord):
-            key = w.axis
-        elif isinstance(w, n.Address):
-            key = w.letter
-        elif isinstance(w, n.Spos):
-            key = "SPOS"
-        elif isinstance(w, n.Meas):
-            key = "MEAS/MEAW"
-        elif isinstance(w, (n.Goto, n.IfGoto)):
-            key = "GOTO"
-        elif isinstance(w, n.Msg):
-            key = "MSG"
-        elif isinstance(w, n.MCode) and w.number == 6:
-            key = "M6"
+    for group in ((3, 4, 5), (0, 2, 17, 30)):
+        same = [m for m in words.ms if m.number in group]
+        if len(same) > 1:
+            raise _err(same[1], f"M{same[1].number} and M{same[0].number} exclude each other in one block")
+
+
+#: the word a block may hold once, by its kind
+_ONCE: tuple[tuple[type | tuple[type, ...], Callable[[Any], str | None]], ...] = (
+    (n.AxisWord, lambda w: w.axis), (n.Address, lambda w: w.letter), (n.Spos, lambda w: "SPOS"),
+    (n.Meas, lambda w: "MEAS/MEAW"), ((n.Goto, n.IfGoto), lambda w: "GOTO"), (n.Msg, lambda w: "MSG"),
+    (n.MCode, lambda w: "M6" if w.number == 6 else None),
+)
+
+
+def _once_key(w) -> str | None:
+    return next((key(w) for kind, key in _ONCE if isinstance(w, kind)), None)
+
+
+def _check_once(words: _Words) -> None:
+    """An axis, an address, SPOS, MEAS, a jump, MSG and M6 stand once in a block."""
+    seen: set[str] = set()
+    for w in words.block.words:
+        key = _once_key(w)
         if key is None:
             continue
         if key in seen:
             raise _err(w, f"{key} is programmed twice in one block")
-        seen[key] = w
-    spos = next((w for w in block.words if isinstance(w, n.Spos)), None)
-    rotate = next((m for m in ms if m.number in (3, 4)), None)
-    if spos is not None and rotate is not None:
-        raise _err(spos, f"SPOS positions the stopped spindle: it cannot stand with M{rotate.number} in one block")
-    axes = [w for w in block.words if isinstance(w, n.AxisWord)]
-    meas = next((w for w in block.words if isinstance(w, n.Meas)), None)
-    calls = [w for w in block.words if isinstance(w, n.CycleCall)]
+        seen.add(key)
+
+
+def _check_calls(words: _Words) -> None:
+    calls = [w for w in words.block.words if isinstance(w, n.CycleCall)]
     if len(calls) > 1:
         raise _err(calls[1], f"only one cycle call per block ({calls[0].name} is already called)")
-    measuring = groups.get(MEASURING)
-    if measuring is not None:
-        code = measuring.number
-        others = [w for w in block.words if not isinstance(w, (n.AxisWord, n.GCode))
-                  and not (code == 100 and isinstance(w, (n.Address, n.Assign)) and _g100_extra_ok(w))]
-        if code in (101, 102):
-            for g in block.gcodes():
-                if g is not measuring:
-                    raise _err(g, f"G{code} takes axis factors only: program G{g.number} in another block")
-            if others:
-                raise _err(others[0], f"G{code} takes axis factors only: program this in another block")
-            if code == 101 and not axes:
-                raise _err(measuring, "G101 needs at least one axis with its factor, e.g. G101 X1")
-        else:  # G100
-            if MOTION in groups:
-                raise _err(groups[MOTION], f"G100 is itself the measuring move: leave out G{groups[MOTION].number}")
-            if FRAME_SUPPRESS in groups:
-                raise _err(groups[FRAME_SUPPRESS], "G100 measures in the workpiece coordinates: leave out G53")
-            if len(axes) == 1 and axes[0].axis not in ("X", "Y", "Z"):
-                raise _err(axes[0], f"G100 measures a geometry axis (X, Y, Z), not {axes[0].axis}")
-            if len(axes) != 1:
-                raise _err(measuring if not axes else axes[1],
-                           "G100 measures one axis: program G100 with exactly one axis and its target, "
-                           "a separate G100 block for each axis")
-            if meas is not None:
-                raise _err(meas, "G100 is itself the measuring move: leave out MEAS/MEAW")
-    if meas is not None:
-        if not axes:
-            raise _err(meas, f"{meas.kind} needs an axis motion in the same block (e.g. {meas.kind}=1 G1 X100)")
-        motion = groups.get(MOTION)
-        if motion is not None and motion.number == 0:
-            raise _err(motion, f"{meas.kind} is a measuring move at feed: program G1, not G0")
+
+
+def _check_spos(words: _Words) -> None:
+    spos = next((w for w in words.block.words if isinstance(w, n.Spos)), None)
+    rotate = next((m for m in words.ms if m.number in (3, 4)), None)
+    if spos is not None and rotate is not None:
+        raise _err(spos, f"SPOS positions the stopped spindle: it cannot stand with M{rotate.number} in one block")
+
+
+def _check_g101_g102(words: _Words) -> None:
+    """G101/G102 take axis factors only."""
+    measuring = words.groups.get(MEASURING)
+    if measuring is None or measuring.number not in (101, 102):
+        return
+    code = measuring.number
+    for g in words.block.gcodes():
+        if g is not measuring:
+            raise _err(g, f"G{code} takes axis factors only: program G{g.number} in another block")
+    others = [w for w in words.block.words if not isinstance(w, (n.AxisWord, n.GCode))]
+    if others:
+        raise _err(others[0], f"G{code} takes axis factors only: program this in another block")
+    if code == 101 and not words.axes:
+        raise _err(measuring, "G101 needs at least one axis with its factor, e.g. G101 X1")
+
+
+def _check_g100(words: _Words) -> None:
+    """G100 is itself the measuring move of one geometry axis (F and assignments may stand with it)."""
+    measuring = words.groups.get(MEASURING)
+    if measuring is None or measuring.number != 100:
+        return
+    groups, axes = words.groups, words.axes
+    if MOTION in groups:
+        raise _err(groups[MOTION], f"G100 is itself the measuring move: leave out G{groups[MOTION].number}")
+    if FRAME_SUPPRESS in groups:
+        raise _err(groups[FRAME_SUPPRESS], "G100 measures in the workpiece coordinates: leave out G53")
+    if len(axes) == 1 and axes[0].axis not in ("X", "Y", "Z"):
+        raise _err(axes[0], f"G100 measures a geometry axis (X, Y, Z), not {axes[0].axis}")
+    if len(axes) != 1:
+        raise _err(measuring if not axes else axes[1],
+                   "G100 measures one axis: program G100 with exactly one axis and its target, "
+                   "a separate G100 block for each axis")
+    if words.meas is not None:
+        raise _err(words.meas, "G100 is itself the measuring move: leave out MEAS/MEAW")
+
+
+def _check_meas(words: _Words) -> None:
+    meas = words.meas
+    if meas is None:
+        return
+    if not words.axes:
+        raise _err(meas, f"{meas.kind} needs an axis motion in the same block (e.g. {meas.kind}=1 G1 X100)")
+    motion = words.groups.get(MOTION)
+    if motion is not None and motion.number == 0:
+        raise _err(motion, f"{meas.kind} is a measuring move at feed: program G1, not G0")
+
+
+#: the block checks, group by group, in the order the operator is told about them
+_BLOCK_CHECKS = (_check_g_groups, _check_m_functions, _check_once, _check_spos, _check_calls, _check_g101_g102,
+                 _check_g100, _check_meas)
+
+
+def _check_block(block: n.Block) -> None:
+    """Words that may not stand together in one block (independent of the configuration)."""
+    words = _Words(block)
+    for check in _BLOCK_CHECKS:
+        check(words)
 
 
 def _g100_extra_ok(word) -> bool:

@@ -145,12 +145,7 @@ class VarDef:
         """The backing key of ``index`` (a tuple of ints, or of one axis name), range-checked."""
         index = tuple(index)
         if self.axis_indexed:
-            if len(index) != 1 or not isinstance(index[0], str):
-                raise IndexOutOfRange(f"{self.name} is indexed by an axis name, e.g. {self.name}[X]")
-            axis = index[0].upper()
-            if axis not in AXIS_LETTERS:
-                raise IndexOutOfRange(f"{self.name}[{index[0]}]: {index[0]} is not an axis")
-            return axis
+            return self._axis_key(index)
         if not self.shape:
             if index:
                 raise IndexOutOfRange(f"{self.name} is not an array and takes no index")
@@ -159,19 +154,29 @@ class VarDef:
             need = ", ".join("i" for _ in self.shape)
             raise IndexOutOfRange(f"{self.name} needs {len(self.shape)} "
                                   f"{'index' if len(self.shape) == 1 else 'indices'}: {self.name}[{need}]")
-        out = []
-        for i, dim in zip(index, self.shape, strict=True):
-            if isinstance(i, str) or isinstance(i, bool):
-                raise IndexOutOfRange(f"{self.name}: an index must be a number")
-            if isinstance(i, float):
-                if not math.isfinite(i) or i != int(i):
-                    raise IndexOutOfRange(f"{self.name}[{_fmt(i)}]: an index must be a whole number")
-                i = int(i)
-            lo, hi = self.first_index, self.first_index + dim - 1
-            if not lo <= i <= hi:
-                raise IndexOutOfRange(f"{self.name}[{i}]: the index must lie within {lo}..{hi}")
-            out.append(int(i))
+        out = [self._element(i, dim) for i, dim in zip(index, self.shape, strict=True)]
         return out[0] if len(out) == 1 else tuple(out)
+
+    def _axis_key(self, index: tuple) -> str:
+        if len(index) != 1 or not isinstance(index[0], str):
+            raise IndexOutOfRange(f"{self.name} is indexed by an axis name, e.g. {self.name}[X]")
+        axis = index[0].upper()
+        if axis not in AXIS_LETTERS:
+            raise IndexOutOfRange(f"{self.name}[{index[0]}]: {index[0]} is not an axis")
+        return axis
+
+    def _element(self, i, dim: int) -> int:
+        """One index: a whole number within the dimension (from ``first_index``)."""
+        if isinstance(i, str) or isinstance(i, bool):
+            raise IndexOutOfRange(f"{self.name}: an index must be a number")
+        if isinstance(i, float):
+            if not math.isfinite(i) or i != int(i):
+                raise IndexOutOfRange(f"{self.name}[{_fmt(i)}]: an index must be a whole number")
+            i = int(i)
+        lo, hi = self.first_index, self.first_index + dim - 1
+        if not lo <= i <= hi:
+            raise IndexOutOfRange(f"{self.name}[{i}]: the index must lie within {lo}..{hi}")
+        return int(i)
 
     def coerce(self, value: Any) -> Value:
         """``value`` as this variable's type (INT rounds half away from zero, like the 840D)."""

@@ -322,18 +322,22 @@ class MachineService:
         feed = self._check_feed(feed)
         return self._run(lambda: self._machine.jog(axis, distance, feed))
 
-    def jog_continuous(self, axis: str, direction: int, feed: float | None = None) -> dict:
+    def jog_continuous(self, axis: str, direction: int, feed: float | None = None, tab: str | None = None,
+                       press: int | None = None) -> dict:
         """Hold-to-run (design.md §9.1): starts the jog, or renews the running one of the same
-        axis and direction, for at most ``HOLD_S``; without a renewal the axis stops."""
+        axis and direction, for at most ``HOLD_S``; without a renewal the axis stops.
+
+        ``tab``/``press`` (issue 24 §6): the browser tab and its key press; a renewal of a press
+        already released (queued behind the release) or of a tab whose live feed dropped is ignored."""
         axis = self._check_axis(axis)
         if direction not in (-1, 1):
             raise InvalidInput("direction: must be -1 or +1", field="direction")
         feed = self._check_feed(feed)
-        if not self._hold.renew(axis, direction):
+        if not self._hold.renew(axis, direction, tab, press) and not self._hold.stale(tab, press):
             self.interlock("jog")
             self._ensure_idle()
             with self._machine_errors():
-                self._hold.start(axis, direction, feed)
+                self._hold.start(axis, direction, feed, tab, press)
         return self.status()
 
     def stop(self) -> dict:
@@ -345,12 +349,21 @@ class MachineService:
         """Another motion takes over the axes: the hold-to-run watchdog lets go of them."""
         self._hold.release()
 
-    def stop_jog(self) -> dict:
+    def stop_jog(self, tab: str | None = None, press: int | None = None) -> dict:
         """The operator let go of a jog key: stop the continuous jog if one is held, nothing else
-        (a late key-up must not stop the measurement NC Start has started since)."""
-        if self._hold.release():
+        (a late key-up must not stop the measurement NC Start has started since). With ``tab`` and
+        ``press`` only that tab's jog stops, and later renewals of that press are ignored."""
+        if self._hold.release(tab, press):
             self._machine.stop()
         return self.status()
+
+    def tab_gone(self, tab: str) -> None:
+        """The live feed of ``tab`` dropped (the browser died or left): its held jog stops now."""
+        if self._hold.tab_gone(tab):
+            self._machine.stop()
+
+    def tab_back(self, tab: str) -> None:
+        self._hold.tab_back(tab)
 
     def close(self) -> None:
         self._hold.close()
@@ -761,36 +774,80 @@ class HoldToRun:
 
     HOLD_S = 0.5
     PERIOD_S = 0.05
+    MAX_TABS = 4096
 
     def __init__(self, machine: Machine):
         self._machine = machine
         self._lock = threading.Lock()
         self._jog: tuple[str, int] | None = None
+        self._holder: tuple[str | None, int | None] = (None, None)     # (tab, press) holding the jog
+        self._released: dict[str, int] = {}        # tab -> its highest released key press
+        self._gone: set[str] = set()               # tabs whose live feed dropped
         self._deadline = 0.0
         self._closed = threading.Event()
         self._thread: threading.Thread | None = None
 
-    def start(self, axis: str, direction: int, feed: float | None) -> None:
+    def _stale(self, tab: str | None, press: int | None) -> bool:
+        if tab is None:
+            return False
+        return tab in self._gone or (press is not None and press <= self._released.get(tab, 0))
+
+    def stale(self, tab: str | None, press: int | None) -> bool:
+        """A request of a released press or of a tab that is gone: it must not move anything."""
         with self._lock:
+            return self._stale(tab, press)
+
+    def start(self, axis: str, direction: int, feed: float | None, tab: str | None = None,
+              press: int | None = None) -> None:
+        with self._lock:
+            if self._stale(tab, press):          # the release overtook this start
+                return
             self._machine.jog_continuous(axis, direction, feed)
             self._jog, self._deadline = (axis, direction), time.monotonic() + self.HOLD_S
+            self._holder = (tab, press)
             if self._thread is None:
                 self._thread = threading.Thread(target=self._watch, name="hold-to-run", daemon=True)
                 self._thread.start()
 
-    def renew(self, axis: str, direction: int) -> bool:
-        """Renew the running jog of ``axis``/``direction``; False when there is none."""
+    def renew(self, axis: str, direction: int, tab: str | None = None, press: int | None = None) -> bool:
+        """Renew the running jog of ``axis``/``direction`` (of this tab's press when given);
+        False when there is none."""
         with self._lock:
             if self._jog != (axis, direction) or not self._machine.status().busy:
+                return False
+            if tab is not None and (self._holder != (tab, press) or self._stale(tab, press)):
                 return False
             self._deadline = time.monotonic() + self.HOLD_S
             return True
 
-    def release(self) -> bool:
-        """Forget the held jog; True when one was held."""
+    def release(self, tab: str | None = None, press: int | None = None) -> bool:
+        """Forget the held jog; True when one was held. With ``tab`` (and ``press``): the release
+        of that key press: later requests of it are stale, another tab's jog is not touched."""
         with self._lock:
+            if tab is not None and press is not None:
+                self._released[tab] = max(press, self._released.get(tab, 0))
+                if len(self._released) > self.MAX_TABS:
+                    self._released.pop(next(iter(self._released)))
+            if tab is not None and self._holder[0] not in (None, tab):
+                return False
             held, self._jog = self._jog is not None, None
             return held
+
+    def tab_gone(self, tab: str) -> bool:
+        """The tab's live feed dropped: True when it held the jog (now forgotten)."""
+        with self._lock:
+            self._gone.add(tab)
+            self._released.pop(tab, None)
+            if len(self._gone) > self.MAX_TABS:       # page loads make new tabs: forget the oldest
+                self._gone = set(list(self._gone)[-self.MAX_TABS // 2:])
+            if self._jog is None or self._holder[0] != tab:
+                return False
+            self._jog = None
+            return True
+
+    def tab_back(self, tab: str) -> None:
+        with self._lock:
+            self._gone.discard(tab)
 
     def close(self) -> None:
         self._closed.set()

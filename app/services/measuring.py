@@ -93,17 +93,18 @@ class MeasuringEnv:
         stop the measurement's motion (a late renewal may have restarted the jog)."""
         self._ms.release_jog()
 
-    def _stored(self, tool_no: int | None, gud) -> tuple:
+    def _stored(self, tool_no: int | None, gud, probe_number: int | None = None) -> tuple:
         """(frames, tool row, probe number, probe record, tool-probe record) as stored; read once
-        per database generation (nothing written since: the same values)."""
-        key = (self._db.generation, tool_no, int(gud.probe_number), int(gud.tool_probe_number))
+        per database generation (nothing written since: the same values). ``probe_number``: the
+        record a cycle names (_PRNUM), else the one bound to the tool in the spindle."""
+        key = (self._db.generation, tool_no, int(gud.probe_number), int(gud.tool_probe_number), probe_number)
         cached = self._cache
         if cached is not None and cached[0] == key:
             return cached[1]
         with self._db.unit(readonly=True) as unit:
             offsets = {n: Frame.from_api(f) for n, f in unit.list_offsets().items()}
             tool = unit.get_tool(tool_no) if tool_no is not None else None
-            probe_no = probe_number_for(unit.list_probes(), tool_no, int(gud.probe_number))
+            probe_no = probe_number or probe_number_for(unit.list_probes(), tool_no, int(gud.probe_number))
             probe_data = unit.get_probe(probe_no)
             tool_probe = unit.get_tool_probe(int(gud.tool_probe_number))
             lathe = lathe_records(unit) if self._ms.is_lathe else None
@@ -111,12 +112,13 @@ class MeasuringEnv:
         self._cache = (key, value)
         return value
 
-    def measuring_context(self) -> MeasuringContext:
+    def measuring_context(self, probe_number: int | None = None) -> MeasuringContext:
+        """``probe_number``: the probe record a measuring cycle names with _PRNUM (read and written)."""
         if current_actor() is not None:     # NC Start asks for the context in the request's thread
             self._start_actor = current_actor()
         st = self._ms.machine.status()
         gud = self._settings.get()
-        offsets, tool, probe_no, probe_data, tool_probe, lathe = self._stored(st.tool, gud)
+        offsets, tool, probe_no, probe_data, tool_probe, lathe = self._stored(st.tool, gud, probe_number)
         tool = dict(tool) if tool is not None else None            # callers may not change the cache
         probe_data = dict(probe_data) if probe_data is not None else None
         is_probe = is_probe_tool(tool)
@@ -252,6 +254,12 @@ class MeasuringEnv:
         entry["result"] = {**(entry.get("result") or {}), **outcome.result}
         entry["correction"] = outcome.correction
         return outcome
+
+    def guard_off(self, task: str) -> None:
+        """``params.guard: false`` (design.md §10.1): only at the ``settings`` level, audited."""
+        check_actor(self._settings, ["settings"])
+        with self._db.unit() as unit:
+            unit.add_audit("guard", task, {"guard": True}, {"guard": False}, "measure", {"task": task})
 
     def activate(self, name: str) -> None:
         self._ms.activate(name)

@@ -13,6 +13,9 @@ from db import Database
 MEMORY_COUNT = 20
 KINDS = {"ev": "EV", "mv": "MV"}
 MAX_VALUE = 1000.0          # mm: a memory beyond is a typo
+#: the access function a memory write needs on every route (API, screen, NC program, NC variables;
+#: the level table: "offsets ... EV/MV memories")
+WRITE_FUNCTION = "offsets"
 
 
 def check_value(value, field: str = "value") -> float:

@@ -34,12 +34,13 @@ from app.machine.protocol import MachineAlarm, MachineBusy
 from app.nc import Interpreter, NcRuntimeError, NcStateError, NcSyntaxError, VariableError, Variables
 from app.nc.cycles import measuring_cycles
 from app.nc.interpreter import CycleContext
+from app.nc.nodes import Assign
 from app.nc.parser import MAX_PROGRAM_BYTES
 from app.nc.runtime import MeasureResult
 from app.nc.variables import InvalidValue
 from app.services.machine_service import MachineService
 from app.services.measuring import MeasuringEnv
-from app.services.memories import MEMORY_COUNT
+from app.services.memories import MEMORY_COUNT, WRITE_FUNCTION
 from app.services.memories import check_value as check_memory_value
 from app.services.protocols import ProtocolFileStore
 from app.services.settings import SettingsService
@@ -53,6 +54,23 @@ log = logging.getLogger(__name__)
 
 XYZ = ("X", "Y", "Z")
 MDA = "MDA"
+#: NC variables that are the HMI's stored data -> the access function their write needs on every
+#: route (JSON API, screen, MDA, AUTO): one write path (issue 24 §7); the value checks and the
+#: audit row are the data's own (``_memory_backing``: the memories' range, ``put_memory``'s audit)
+PROTECTED = {"_EV": WRITE_FUNCTION, "_MV": WRITE_FUNCTION}
+
+
+def protected_function(reference: str) -> str | None:
+    """The access function a write of ``reference`` (``_EV[9]``, ``r1``) needs, or None."""
+    return PROTECTED.get(reference.split("[", 1)[0].strip().upper())
+
+
+class WriteRefused(VariableError):
+    """A program assigns stored data its starter may not write: 17070, nothing written."""
+
+    alarm = alarms.NC_WRITE_PROTECTED
+
+
 #: how long a Reset waits for the program thread after its motion was aborted
 RESET_WAIT_S = 2.0
 #: what the mode group refuses from outside a running program (MachineService.interlock actions)
@@ -204,7 +222,7 @@ class NcMeasuringEnv:
         return dataclasses.replace(setup, plane=self._plane, settings=self._gud(setup.settings))
 
     def measuring_context(self):
-        ctx = self._base.measuring_context()
+        ctx = self._base.measuring_context(probe_number=self._settings.get("probe_record"))
         return dataclasses.replace(ctx, plane=self._plane, settings=self._gud(ctx.settings))
 
     def commit_measurement(self, *, log_entry: dict, **commit):
@@ -287,7 +305,7 @@ class NcService:
         self._settings = settings
         self.runtime = MachineRuntime(machine_service, db)
         self.variables = Variables(axes=machine_service.axes, backings={
-            "_EV": _memory_backing(db, "EV"), "_MV": _memory_backing(db, "MV")})
+            "_EV": _memory_backing(db, "EV", self._may_write), "_MV": _memory_backing(db, "MV", self._may_write)})
         self.protocol_files = ProtocolFileStore(db)     # CYCLE100..CYCLE106 write here (design.md §10.3)
         self.cycles = measuring_cycles(self)
         self.interpreter = Interpreter(self.runtime, self.variables, self.cycles)
@@ -309,6 +327,27 @@ class NcService:
         allow it (the API and the screens hand in their check with the run)."""
         if self._authorize is not None:
             self._authorize(category, target)
+
+    def _may_write(self, name: str) -> None:
+        """Before a program's write of stored data lands: the starter's level (17070 else)."""
+        function = PROTECTED.get(name)
+        if function is None or self._authorize is None or threading.current_thread() is not self._thread:
+            return
+        try:
+            self._authorize(None, None, function=function)
+        except HmiError as exc:
+            raise WriteRefused(f"{name}: {exc.message}") from None
+
+    def _check_writes(self, authorize) -> None:
+        """Before NC Start: every assignment of the program to stored data must be allowed to
+        who starts it (403 ``access_level``, nothing moved), as the JSON API refuses it."""
+        program = self.interpreter.program
+        if authorize is None or program is None:
+            return
+        names = {w.target.name for b in program.blocks for w in b.words
+                 if isinstance(w, Assign) and w.target.name in PROTECTED}
+        for name in sorted(names):
+            authorize(None, None, function=PROTECTED[name])
 
     def measuring(self, ctx: CycleContext, settings: Mapping[str, Any], cycle: Mapping[str, Any]):
         block = ctx.block
@@ -418,6 +457,7 @@ class NcService:
             elif mda is not None:                 # always here: exactly one of them was given
                 self.mda_text = mda
                 self._load(mda, MDA, "mda")
+            self._check_writes(authorize)
             if single_block is not None:
                 self.single_block = bool(single_block)
             self._launch(authorize)
@@ -442,6 +482,7 @@ class NcService:
                 raise ConflictError("the channel has an alarm: press Reset first", code="alarm")
             if state == "done":
                 self.interpreter.load(self._text, self._source)
+            self._check_writes(authorize)
             if single_block is not None:
                 self.single_block = bool(single_block)
             self._launch(authorize)
@@ -568,8 +609,9 @@ class NcService:
                 thread.join(5.0)
 
 
-def _memory_backing(db: Database, kind: str):
-    """_EV[i] / _MV[i] = memory n = i + 1 of the database (the same memories JOG uses)."""
+def _memory_backing(db: Database, kind: str, may_write):
+    """_EV[i] / _MV[i] = memory n = i + 1 of the database (the same memories JOG uses);
+    ``may_write(name)`` raises when the program's starter may not write them."""
     from app.nc import CallbackBacking
 
     def read(key):
@@ -583,6 +625,7 @@ def _memory_backing(db: Database, kind: str):
         n = int(key) + 1
         if not 1 <= n <= MEMORY_COUNT:
             raise VariableError(f"_{kind}[{key}]: memory {n} is beyond the {MEMORY_COUNT} memories")
+        may_write(f"_{kind}")
         try:        # the range of /api/memories: a program cannot store what the API refuses
             number = check_memory_value(value, f"_{kind}[{key}]")
         except InvalidInput as exc:

@@ -187,6 +187,16 @@ class ResultsService:
             raise NotFoundError(f"no part {part_id}", field="part_id")
         return self._part_answer(part)
 
+    def probe_of(self, part: dict) -> int | None:
+        """The workpiece probe record the part's newest value was measured with."""
+        ids = [c["log_id"] for c in part["characteristics"] if c.get("log_id")]
+        if not ids:
+            return None
+        with self._db.unit(readonly=True) as unit:
+            entry = unit.get_log(max(ids)) or {}
+        probe = entry.get("probe")
+        return int(probe["number"]) if isinstance(probe, dict) and probe.get("number") else None
+
     def series(self, part_number: str, characteristic: str | None = None) -> list[dict]:
         """The characteristics of every part of ``part_number``, in measuring order."""
         with self._db.unit(readonly=True) as unit:

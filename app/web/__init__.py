@@ -14,6 +14,7 @@ from . import (
     nc,
     offsets,
     panel,
+    parts,
     plant,
     plc,
     probes,
@@ -29,7 +30,8 @@ from . import (
 
 web_router = APIRouter(include_in_schema=False, dependencies=[Depends(guard)])   # app/access/deps.py
 for module in (panel, jog, offsets, tools, machine_view, settings, tilted_setup, measure, tool_probes,
-               task_screens, log, setup_support, probes, plc, signin, docs, nc, memories, task_help, plant):
+               task_screens, log, setup_support, probes, plc, signin, docs, nc, memories, task_help, parts,
+               plant):
     web_router.include_router(module.router)
 
 __all__ = ["web_router"]

@@ -75,7 +75,7 @@ def log_screen(request: Request, log: LogDep, page: Annotated[int, Query(ge=1, l
 # the first nine as before (extended, never renamed), then every other log field
 CSV_COLUMNS = ("id", "time", "task", "target", "status", "result", "correction", "result_json",
                "correction_json", "local_time", "measuring_wo", "warnings", "program", "block", "probe",
-               "params_json", "raw_json", "points_json", "probe_json")
+               "params_json", "raw_json", "points_json", "probe_json", "part_id")
 
 
 def _local_zone(tz: str | None):
@@ -112,7 +112,8 @@ def _csv_row(entry: dict, zone) -> list:
             " | ".join(str(w.get("text", w)) if isinstance(w, dict) else str(w) for w in warnings),
             entry.get("program") or "", entry.get("block") or "",
             f"probe {probe.get('number')}" if probe.get("number") is not None else "",
-            as_json["params"], as_json["raw"], as_json["points"], as_json["probe"]]
+            as_json["params"], as_json["raw"], as_json["points"], as_json["probe"],
+            entry.get("part_id") if entry.get("part_id") is not None else ""]
 
 
 @router.get("/log/export.csv", name="log_export_csv")

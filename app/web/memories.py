@@ -10,6 +10,7 @@ from fastapi import APIRouter, Form, Request
 from app.access.deps import needs
 from app.deps import MachineDep, MemoriesDep
 from app.errors import HmiError
+from app.services.memories import WRITE_FUNCTION as MEMORY_WRITE
 
 from .templating import render_block, render_screen
 
@@ -37,7 +38,7 @@ def memories_screen(request: Request, memories: MemoriesDep):
                                                     "rows": memory_rows(memories.list())})
 
 
-@router.post("/memories/{kind}/{n}", name="memories_edit_cell", dependencies=[needs("tools")])
+@router.post("/memories/{kind}/{n}", name="memories_edit_cell", dependencies=[needs(MEMORY_WRITE)])
 def edit_cell(request: Request, kind: str, n: int, memories: MemoriesDep, value: Annotated[str, Form()] = ""):
     text = value.strip()
     try:

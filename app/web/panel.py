@@ -124,22 +124,35 @@ def handwheel(request: Request, machine: MachineDep, detents: Annotated[str, For
 
 @router.post("/ui/jog/start", name="panel_jog_start", dependencies=[needs("jog")])
 def jog_start(request: Request, machine: MachineDep, direction: Annotated[str, Form()],
-              axis: Annotated[str | None, Form()] = None, rapid: Annotated[str | None, Form()] = None):
+              axis: Annotated[str | None, Form()] = None, rapid: Annotated[str | None, Form()] = None,
+              tab: Annotated[str | None, Form()] = None, press: Annotated[str | None, Form()] = None):
     """Press-and-hold: starts or renews the continuous jog (hold-to-run: the tab renews it while
     the key is held; without a renewal the axis stops after 0.5 s, design.md §9.1)."""
     if direction not in DIRECTIONS:
         return message(request, "direction must be + or -", "error")
     try:
         machine.jog_continuous(_jog_axis(request, machine, axis), DIRECTIONS[direction],
-                               _jog_feed(request, machine, rapid))
+                               _jog_feed(request, machine, rapid), *_held_by(tab, press))
     except HmiError as exc:
         return message(request, exc.message, "error")
     return message(request)
 
 
+def _held_by(tab: str | None, press: str | None) -> tuple[str | None, int | None]:
+    """The tab and key press of a hold-to-run request (issue 24 §6); malformed: none (the old way)."""
+    if not tab or len(tab) > 64 or not tab.replace("-", "").replace("_", "").isalnum():
+        return None, None
+    try:
+        number = int(press) if press else None
+    except ValueError:
+        number = None
+    return tab, (number if number is not None and 0 < number < 2**31 else None)
+
+
 @router.post("/ui/jog/stop", name="panel_jog_stop", dependencies=[needs("view")])
-def jog_stop(request: Request, machine: MachineDep):
-    machine.stop_jog()
+def jog_stop(request: Request, machine: MachineDep, tab: Annotated[str | None, Form()] = None,
+             press: Annotated[str | None, Form()] = None):
+    machine.stop_jog(*_held_by(tab, press))
     return message(request)
 
 

@@ -20,7 +20,7 @@ import numpy as np
 
 from app.services import trainer
 from app.services.measuring import MeasuringEnv
-from app.workflow import planning
+from app.workflow import guard, planning
 from app.workflow.executor import StepExecutor
 from app.workflow.tasks import TASKS
 from engine.frames import Frame, chain_of, is_basic
@@ -98,6 +98,16 @@ def _plan(services, session) -> dict | None:
         log.exception("the 3D view's planned path")
         return None
     to_mcs = wcs2bcs.child2parent if spec.coords == "WCS" else (lambda p: np.asarray(p, dtype=float))
+    if guard.guarded(spec) and spec.coords == "WCS":
+        try:       # the start guard's path and verdicts (issue 24 §1): the refused segment is marked
+            report, _coords = guard.check_point(services.machine.machine, spec, session.params, n, ctx)
+        except EXPECTED:
+            report = None
+        if report is not None:
+            return {"task": session.task, "point": n, "refused_step": getattr(report.refusal, "index", None),
+                    "segments": [{"kind": seg.kind, "verdict": seg.verdict, "from": _vec(to_mcs(seg.start)),
+                                  "to": _vec(to_mcs(seg.where if seg.kind == "probe" and seg.where is not None
+                                                    else seg.end))} for seg in report.segments]}
     segments, pos = [], start
     for step in steps:
         if isinstance(step, MoveStep):

@@ -141,6 +141,7 @@ templates.env.globals["record_places"] = units.record_places
 templates.env.globals["alarm_text"] = texts.alarm_text
 templates.env.globals["alarm_remedy"] = texts.alarm_remedy
 templates.env.globals["program_state_text"] = texts.program_state_text
+templates.env.globals["verdict_text"] = texts.verdict_text
 templates.env.globals["increment_text"] = texts.increment_text
 templates.env.globals["field_name"] = texts.field_name
 templates.env.globals["label_text"] = texts.label_text

@@ -16,6 +16,7 @@ from app.i18n import N_, _, language
 from engine import alarms as catalogue
 
 PROGRAM_STATES = {"active": N_("active"), "interrupted": N_("interrupted"), "reset": N_("reset")}
+VERDICTS = {"ok": N_("OK"), "rework": N_("rework"), "scrap": N_("scrap"), "not_decidable": N_("not decidable")}
 
 
 def _definition(code, text: str | None):
@@ -53,6 +54,11 @@ def alarm_remedy(alarm) -> str:
 
 def program_state_text(state: str) -> str:
     return _(PROGRAM_STATES.get(state, state))
+
+
+def verdict_text(verdict: str) -> str:
+    """A part's or characteristic's verdict in the operator's language (design.md §10.3)."""
+    return _(VERDICTS.get(verdict, verdict))
 
 
 def increment_text(increment: str, gud) -> str:

@@ -16,7 +16,7 @@ import numpy as np
 
 from app.errors import ModeError, WorkflowError
 from app.machine.protocol import MachineAlarm
-from app.workflow import probe_trust
+from app.workflow import guard, probe_trust
 from app.workflow.context import (
     MEASURE_ONLY,
     MeasuringContext,
@@ -98,6 +98,8 @@ class WorkflowService:
 
     def create(self, task: str, params: dict, target: str | dict | None = None) -> MeasureSession:
         spec = self.spec(task)
+        params = dict(params or {})
+        guard_on = self._guard_switch(params.pop("guard", True), task)
         ctx = self._env.measuring_setup()
         wanted = ctx.settings.measuring_wo           # _JM_I[4]: the WO active while measuring (jog-measuring §4.4)
         if wanted != "active" and wanted != ctx.active_offset and not (self._session and self._session.running):
@@ -121,9 +123,21 @@ class WorkflowService:
                 raise WorkflowError(409, "busy", "a measurement is running; press Reset first")
             self._session = MeasureSession.create(task, normalised, chosen, ctx.active_offset,
                                                   spec.points_of(normalised))
+            self._session.guard = guard_on
             return self._session
         finally:
             self._lock.release()
+
+    def _guard_switch(self, value, task: str) -> bool:
+        """``params.guard``: true (default) or false; false needs the ``settings`` level and is
+        audited (design.md §10.1)."""
+        if not isinstance(value, bool):
+            raise WorkflowError(400, "invalid_param", "guard: true or false", "guard")
+        if not value:
+            switch_off = getattr(self._env, "guard_off", None)
+            if callable(switch_off):
+                switch_off(task)
+        return value
 
     def _check_machine_kind(self, spec: TaskSpec) -> None:
         """The lathe tasks need a lathe, the milling tasks a milling machine (turning.md §10.1)."""
@@ -316,12 +330,45 @@ class WorkflowService:
         if distrust and ctx.settings.calibration_invalid == "refuse":
             raise WorkflowError(409, distrust[0].code, distrust[0].message)
         warnings += [f.message for f in distrust]
+        if session.guard and guard.guarded(spec):
+            warnings += self._guard(session, spec, n, ctx)
         session.warnings = warnings
         session.running = True
         session.last_alarm = None
         session.notice = None
         session.progress = {"point": n, "step": 0, "steps": None, "label": ""}
         return spec, n, ctx
+
+    def _guard(self, session: MeasureSession, spec: TaskSpec, n: int, ctx: MeasuringContext) -> list[str]:
+        """The start guard (issue 24 §1): refuse before any motion (409 ``guard``); the warning
+        when the control has no model to check against."""
+        try:
+            report, _coords = guard.check_point(self._env.machine, spec, session.params, n, ctx)
+        except MeasuringError:
+            return []                      # NC Start raises the program's own alarm
+        refused = guard.refusal_error(report, n, ("X", "Y", "Z"), session.params)
+        if refused is not None:
+            raise refused
+        return [guard.UNKNOWN_WARNING] if report.unknown else []
+
+    def plan(self, session_id: str, point: int | None = None) -> dict:
+        """``GET /api/measure/{id}/plan``: the planned segments of a point from where the probe
+        stands, with the guard's verdict per segment (design.md §10.1)."""
+        session = self.get(session_id)
+        n = point if point is not None else (session.next_point() or 1)
+        try:
+            session.slot(n)
+        except KeyError:
+            raise WorkflowError(404, "no_point", f"point P{n} does not exist for {session.task}", "point") from None
+        spec = self.spec(session.task)
+        ctx = self._env.measuring_context()
+        try:
+            report, coords = guard.check_point(self._env.machine, spec, session.params, n, ctx)
+        except MeasuringError as exc:
+            raise WorkflowError(409, "alarm", f"{exc.alarm} {exc.message}") from None
+        answer = guard.plan_to_api(report, n, coords, ("X", "Y", "Z"))
+        answer["guard"] = session.guard
+        return answer
 
     def _check_probe_ready(self, spec: TaskSpec, ctx: MeasuringContext) -> None:
         """A probe that cannot switch refuses NC Start with an alarm, before anything moves

@@ -73,6 +73,7 @@ class MeasureSession:
     progress: dict | None = None        # {"point", "step", "steps", "label"} while NC Start runs
     notice: str | None = None           # why stored points were discarded (tool change, scenario)
     repetitions: int = 0                # repetitions made under the repeat rule (_CBIT[0], measuring-math §3.6)
+    guard: bool = True                  # the start guard checks each point's path (params.guard: false skips it)
 
     @classmethod
     def create(cls, task: str, params: dict, target: str | dict, measuring_wo: str, n_points: int

@@ -168,8 +168,14 @@ def test_61302_collision_in_intermediate_positioning(client):
     before = snapshot(op)
     c = SPIGOTS[0]
     op.ball_to(op.part.mcs(c[0], c[1], SPIGOT_H + 5.0))
-    # the approximate diameter is far too small: "down DZ" lands on the spigot
+    # the approximate diameter is far too small: "down DZ" lands on the spigot. The start guard
+    # refuses it before anything moves (issue 24 §1) ...
     sid = op.create("spigot.1", {"diameter": 4.0, "infeed": 13.0}, "G54")["id"]
+    err = error_of(op.c.post(f"/api/measure/{sid}/start"), 409, "guard")
+    assert "DZ" in err["segment"]["label"] and not op.ok(op.c.get("/api/machine"))["alarms"]
+    assert snapshot(op) == before
+    # ... and without the guard the machine's own monitoring stops the move: 61302
+    sid = op.create("spigot.1", {"diameter": 4.0, "infeed": 13.0, "guard": False}, "G54")["id"]
     err = error_of(op.c.post(f"/api/measure/{sid}/start"), 409, "alarm")
     assert "61302" in err["message"]
     assert 61302 in [a["code"] for a in op.ok(op.c.get("/api/machine"))["alarms"]]

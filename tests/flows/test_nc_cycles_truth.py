@@ -408,6 +408,23 @@ def test_cycle976_calibrates_the_probe_in_the_ring_and_on_a_surface(client):
     assert entry["task"] == "probe.length" and "CYCLE976" in entry["block"]
 
 
+@pytest.mark.parametrize("record", [1, 2, 3])
+def test_cycle976_writes_the_probe_record_prnum_names_and_no_other(client, record):
+    """issue 28 item 2: _PRNUM=n calibrates record n; the other records stay as they were."""
+    data = with_spheres(scenario(rot=(0.0, 0.0, ROT_Z), eccentricity=(0.012, -0.007)))
+    nc = Nc(client, data)
+    nc.load()
+    before = {n: nc.ok(nc.c.get(f"/api/probes/{n}")) for n in (1, 2, 3)}
+    cx, cy, top = data["ring_gauge"]["center"]
+    nc.mda(f"G500 G17 G90 G0 Z-60\nX{cx + 0.3} Y{cy - 0.2}\nZ{top - 8.0}\n"
+           f"_MVAR=10108 _SETVAL=25 _FA=2 _PRNUM={record}\nCYCLE976\nG0 Z-60")
+    assert nc.ovi()[5] == record
+    written = nc.ok(nc.c.get(f"/api/probes/{record}"))
+    close("CYCLE976 _PRNUM", written["skew"], [0.012, -0.007])
+    for n in {1, 2, 3} - {record}:
+        assert nc.ok(nc.c.get(f"/api/probes/{n}")) == before[n], n
+
+
 # --- CYCLE971 -----------------------------------------------------------------------------------------
 
 TP = (700.0, 400.0, -140.0)

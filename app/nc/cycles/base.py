@@ -146,8 +146,16 @@ class Call:
             "tool_offset_geometry": self.bit("_CHBIT", 6),
             "tol_keep_mean": self.bit("_CHBIT", 4),
             "repeat_on_violation": self.bit("_CBIT", 0),
+            "probe_record": self.probe_record(),
             **extra,
         }
+
+    def probe_record(self) -> int:
+        """The workpiece probe record _PRNUM names (its last two digits, manual §2.3.1; 1..3 here)."""
+        number = self.integer("_PRNUM") % 100 or 1
+        if not 1 <= number <= 3:
+            raise CycleAlarm(alarms.NC_VALUE_RANGE, f"_PRNUM = {self.integer('_PRNUM')}: probe record 1..3")
+        return number
 
     def measurements(self) -> int:
         n = self.integer("_NMSP")
@@ -282,6 +290,9 @@ class Call:
         except WorkflowError as exc:
             raise self.alarm_of(exc, session) from None
         except HmiError as exc:          # access level, storage, correction out of range, ...
+            if exc.code == "guard":      # the start guard refused the path: nothing moved (issue 24 §1)
+                code = int((exc.extra.get("alarm") or {}).get("code") or 0)
+                raise CycleAlarm(alarms.by_number(code) or alarms.START_GUARD_COLLISION, exc.message) from None
             definition = alarms.NC_WRITE_PROTECTED if exc.code in ("access_level", "unauthenticated") \
                 else alarms.NC_VALUE_RANGE
             raise CycleAlarm(definition, exc.message) from None

@@ -1,0 +1,304 @@
+"""Start guard: the whole planned path of a point checked before its first motion (issue 24 §1,
+design.md §10.1).
+
+The guard drives a point program (``engine.plan.point_program``) against a *protection model*:
+the solids the control knows (workpiece with its holes, pockets, spigots and bosses, spheres,
+ring gauge, tool probe; ``engine.guard_model``) and the machine limits. Each positioning move
+is a segment of the ball centre's path; it is ``collision`` where the ball (radius r) would
+touch a solid on the way (a switch during positioning is alarm 61302, jog-measuring §2.4
+step 2), ``limit`` where its end lies outside the axis limits (the NC refuses the block), else
+``clear``. A probing move is where contact is wanted: the guard answers it with the first
+contact of its own model along the stroke (the latch the program then continues from), or no
+switch. Positions the model cannot judge (no model at all) are ``unknown``: the answer says so,
+never a silent pass.
+
+Geometry: signed distances of extrusions (a polygon or circle in its local xy, height along its
+local z) and spheres, composed like constructive solid geometry: a body is a solid minus its
+cut-outs (sdf = max(sdf_P, −sdf_N)), the model the union of bodies (min). The contact of a ball
+moving along c0 + s·d is the first s with sdf(c(s)) ≤ r, found by sphere tracing (the composed
+sdf is exact or a lower bound of the distance, so a step of sdf − r never passes a surface).
+Pure numpy: no I/O, nothing of the simulator.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Generator, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from engine.types import FloatArray, Latch, MeasuringError, MoveStep, ProbeStep, Step
+
+CONTACT_EPS = 1e-7          # mm: ball this close to a surface = contact
+MAX_TRACE_STEPS = 20000
+UNSTICK_STEP = 0.01         # mm: a move starting in contact (retract) leaves it in these steps
+
+
+# --- solids ---------------------------------------------------------------------------------
+
+def _polygon_sdf(points: FloatArray, polygon: FloatArray) -> FloatArray:
+    """Signed 2-D distance of ``points`` (n, 2) to a closed polygon (m, 2): < 0 inside."""
+    best = np.full(len(points), np.inf)
+    inside = np.zeros(len(points), dtype=bool)
+    m = len(polygon)
+    for i in range(m):
+        a, b = polygon[i], polygon[(i + 1) % m]
+        e = b - a
+        w = points - a
+        t = np.clip((w @ e) / float(e @ e), 0.0, 1.0)
+        dist = np.linalg.norm(w - t[:, None] * e, axis=1)
+        best = np.minimum(best, dist)
+        # even-odd rule: a horizontal ray to +x crosses this edge
+        cond = (a[1] > points[:, 1]) != (b[1] > points[:, 1])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x_cross = a[0] + (points[:, 1] - a[1]) * e[0] / e[1]
+        inside ^= cond & (points[:, 0] < x_cross)
+    return np.where(inside, -best, best)
+
+
+@dataclass(frozen=True)
+class Solid:
+    """An extrusion (``polygon`` (m, 2) or a circle of ``radius`` in local xy, ``half_height``
+    along local z about the local origin) or, with ``sphere``, a ball of ``radius``; placed by
+    local→MCS = (``rotation``, ``centre``). ``name`` is what the operator reads ("spigot")."""
+
+    name: str
+    centre: FloatArray
+    rotation: FloatArray = field(default_factory=lambda: np.eye(3))
+    radius: float = 0.0
+    half_height: float = 0.0
+    polygon: FloatArray | None = None
+    sphere: bool = False
+
+    def sdf(self, points: FloatArray) -> FloatArray:
+        q = (np.atleast_2d(points) - self.centre) @ self.rotation      # rows: local coordinates
+        if self.sphere:
+            return np.asarray(np.linalg.norm(q, axis=1) - self.radius)
+        if self.polygon is not None:
+            d2 = _polygon_sdf(q[:, :2], self.polygon)
+        else:
+            d2 = np.linalg.norm(q[:, :2], axis=1) - self.radius
+        dz = np.abs(q[:, 2]) - self.half_height
+        outside = np.hypot(np.maximum(d2, 0.0), np.maximum(dz, 0.0))
+        return np.asarray(np.minimum(np.maximum(d2, dz), 0.0) + outside)
+
+
+@dataclass(frozen=True)
+class Body:
+    """A solid minus its cut-outs (a block with holes, a ring with its bore)."""
+
+    solid: Solid
+    cutouts: tuple[Solid, ...] = ()
+
+    @property
+    def name(self) -> str:
+        return self.solid.name
+
+    def sdf(self, points: FloatArray) -> FloatArray:
+        value = self.solid.sdf(points)
+        for cut in self.cutouts:
+            value = np.maximum(value, -cut.sdf(points))
+        return value
+
+
+@dataclass(frozen=True)
+class ProtectionModel:
+    """What the control knows of the work space (MCS): bodies and axis limits.
+
+    ``known`` False: there is no model (a controller without one): every positioning move is
+    ``unknown``. ``limits``: axis -> (low, high) of the tool reference point."""
+
+    bodies: tuple[Body, ...] = ()
+    limits: dict[str, tuple[float, float]] = field(default_factory=dict)
+    known: bool = True
+
+    def sdf(self, point: npt.ArrayLike) -> tuple[float, str]:
+        """(distance, name of the nearest body) of one point."""
+        p = np.atleast_2d(np.asarray(point, dtype=float))
+        best, name = math.inf, ""
+        for body in self.bodies:
+            v = float(body.sdf(p)[0])
+            if v < best:
+                best, name = v, body.name
+        return best, name
+
+
+def first_contact(model: ProtectionModel, c0: npt.ArrayLike, c1: npt.ArrayLike, radius: float
+                  ) -> tuple[float, str] | None:
+    """First s in [0, |c1 − c0|] where a ball of ``radius`` moving c0 → c1 touches the model,
+    with the body's name; None when the way is free. A ball that starts in contact and moves away
+    or slides along the surface is free until its next contact; pressing deeper is s = 0."""
+    a, b = np.asarray(c0, dtype=float), np.asarray(c1, dtype=float)
+    length = float(np.linalg.norm(b - a))
+    if length <= 0.0 or not model.bodies:
+        return None
+    d = (b - a) / length
+    g, name = model.sdf(a)
+    s = 0.0
+    if g - radius <= CONTACT_EPS:
+        step = 1e-6
+        ahead, _ = model.sdf(a + step * d)
+        if ahead < g - 1e-6 * step:
+            return 0.0, name
+        while s < length and g - radius <= CONTACT_EPS:
+            s = min(length, s + UNSTICK_STEP)
+            g, name = model.sdf(a + s * d)
+        if g - radius <= CONTACT_EPS:
+            return None
+    for _ in range(MAX_TRACE_STEPS):
+        g, name = model.sdf(a + s * d)
+        gap = g - radius
+        if gap <= CONTACT_EPS:
+            return s, name
+        s += gap
+        if s > length:
+            return None
+    return s, name          # a grazing pass that never resolves: treated as a contact
+
+
+# --- the check ------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Placement:
+    """Where the plan's coordinates lie in the model: ball centre (MCS) = rotation·p + ball_shift,
+    axes (tool reference point, MCS) = rotation·p + axes_shift; ``ball_radius`` of the probe."""
+
+    rotation: FloatArray
+    ball_shift: FloatArray
+    axes_shift: FloatArray
+    ball_radius: float
+
+    def ball(self, p: npt.ArrayLike) -> FloatArray:
+        return np.asarray(self.rotation @ np.asarray(p, dtype=float) + self.ball_shift)
+
+    def axes(self, p: npt.ArrayLike) -> FloatArray:
+        return np.asarray(self.rotation @ np.asarray(p, dtype=float) + self.axes_shift)
+
+    def back(self, ball_mcs: npt.ArrayLike) -> FloatArray:
+        return np.asarray(self.rotation.T @ (np.asarray(ball_mcs, dtype=float) - self.ball_shift))
+
+
+@dataclass(frozen=True)
+class Segment:
+    """One planned motion: ``kind`` "move"/"probe", plan coordinates, and the guard's verdict
+    (``clear``, ``collision``, ``limit``, ``unknown``; a probing move ``contact`` or
+    ``no_switch``); ``where`` the contact point (plan coordinates) and ``body`` what is hit."""
+
+    index: int
+    label: str
+    kind: str
+    start: FloatArray
+    end: FloatArray
+    verdict: str
+    body: str = ""
+    where: FloatArray | None = None
+    axis: str = ""
+
+    @property
+    def refused(self) -> bool:
+        return self.verdict in ("collision", "limit")
+
+
+@dataclass(frozen=True)
+class GuardReport:
+    segments: tuple[Segment, ...]
+    complete: bool           # the program ran to its end (False: refused, or it stopped itself)
+
+    @property
+    def refusal(self) -> Segment | None:
+        return next((s for s in self.segments if s.refused), None)
+
+    @property
+    def unknown(self) -> bool:
+        return any(s.verdict == "unknown" for s in self.segments)
+
+
+AXES = ("X", "Y", "Z")
+
+
+def _limit_axis(model: ProtectionModel, axes: FloatArray) -> str:
+    for i, axis in enumerate(AXES):
+        bounds = model.limits.get(axis)
+        if bounds is not None and not bounds[0] - 1e-9 <= float(axes[i]) <= bounds[1] + 1e-9:
+            return axis
+    return ""
+
+
+def check_program(program: Generator[Step, Latch | None, object], start: npt.ArrayLike,
+                  model: ProtectionModel, placement: Placement) -> GuardReport:
+    """Drive ``program`` from ``start`` (plan coordinates) against ``model``; stop at the first
+    refused segment. Probing moves are answered with the model's first contact along the stroke
+    (the latch = the NC reference there), so the path after a touch is the one the machine will
+    take when the part is where the model says."""
+    pos = np.asarray(start, dtype=float)
+    segments: list[Segment] = []
+    r = placement.ball_radius
+    reply: Latch | None = None
+    complete = False
+    try:
+        while True:
+            step = program.send(reply)
+            reply = None
+            if isinstance(step, MoveStep):
+                target = np.asarray(step.target, dtype=float)
+                seg = _move_segment(len(segments) + 1, step.label, pos, target, model, placement)
+                segments.append(seg)
+                if seg.refused:
+                    break
+                pos = target
+            elif isinstance(step, ProbeStep):
+                d = np.asarray(step.direction, dtype=float)
+                end = pos + float(step.distance) * d
+                if not model.known:
+                    hit_s: float | None = step.expected if step.expected is not None else step.distance / 2.0
+                    body, verdict = "", "unknown"
+                else:
+                    hit = first_contact(model, placement.ball(pos), placement.ball(end), r)
+                    hit_s, body = (hit if hit is not None else (None, ""))
+                    verdict = "contact" if hit is not None else "no_switch"
+                axis = _limit_axis(model, placement.axes(end))
+                if axis and hit_s is None:
+                    segments.append(Segment(len(segments) + 1, step.label, "probe", pos, end, "limit", axis=axis))
+                    break
+                where = None if hit_s is None else pos + float(hit_s) * d
+                segments.append(Segment(len(segments) + 1, step.label, "probe", pos, end, verdict, body, where))
+                if where is not None:
+                    pos = where
+                    reply = Latch(triggered=True, rec=where.copy())
+                else:
+                    pos = end
+                    reply = Latch(triggered=False)
+    except StopIteration:
+        complete = True
+    except MeasuringError:
+        pass                 # the program stops itself (no switch: 61301) before any harm
+    return GuardReport(tuple(segments), complete)
+
+
+def _move_segment(index: int, label: str, a: FloatArray, b: FloatArray, model: ProtectionModel,
+                  placement: Placement) -> Segment:
+    axis = _limit_axis(model, placement.axes(b))
+    if axis:
+        return Segment(index, label, "move", a, b, "limit", axis=axis)
+    if not model.known:
+        return Segment(index, label, "move", a, b, "unknown")
+    hit = first_contact(model, placement.ball(a), placement.ball(b), placement.ball_radius)
+    if hit is None:
+        return Segment(index, label, "move", a, b, "clear")
+    s, body = hit
+    d = b - a
+    where = a + (s / float(np.linalg.norm(d))) * d if np.linalg.norm(d) > 0 else a
+    return Segment(index, label, "move", a, b, "collision", body, where)
+
+
+def segments_to_api(segments: Sequence[Segment], axes: Sequence[str] = AXES, point: int | None = None
+                    ) -> list[dict[str, Any]]:
+    def xyz(v: FloatArray | None) -> dict[str, float] | None:
+        return None if v is None else {a: float(x) for a, x in zip(axes, v, strict=True)}
+
+    return [{"point": point, "step": s.index, "label": s.label, "kind": s.kind, "from": xyz(s.start),
+             "to": xyz(s.end), "verdict": s.verdict, "body": s.body or None, "at": xyz(s.where),
+             "axis": s.axis or None} for s in segments]
