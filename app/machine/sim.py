@@ -168,8 +168,10 @@ class SimulatedMachine:
             position = self._motion.position
             mcs = self._kinematics.as_dict(position)
             tool_length = self._offset_length if self._tool is not None else 0.0
-            axis = self._kinematics.tool_axis(position)
-            tip_in_mcs = position[XYZ] - tool_length * axis
+            # what the NC computes from its kinematic data (design.md §10.6), not the truth
+            axis = self._kinematics.nc_tool_axis(position)
+            shift = self._kinematics.nc_head_shift(position)
+            tip_in_mcs = position[XYZ] + shift - tool_length * axis
             p_in_wcs = self._bcs2wcs @ np.append(tip_in_mcs, 1.0)
             wcs = {a: float(p_in_wcs[i]) for i, a in enumerate(GEOMETRY_AXES)}
             for a in self.axes[3:]:
@@ -181,6 +183,7 @@ class SimulatedMachine:
                 spindle_angle=self._spindle_angle, spindle_speed=self._spindle_speed,
                 busy=self._motion.busy, alarms=tuple(self._alarms),
                 tool_axis=(float(axis[0]), float(axis[1]), float(axis[2])),
+                head_shift=(float(shift[0]), float(shift[1]), float(shift[2])),
                 probe=self._probes.state(WORKPIECE, self._contact.is_probe(self._tool), on_probe),
                 tool_probe=self._probes.state(TOOL, True, on_tool_probe) if self._probes.has(TOOL) else None)
 
@@ -451,6 +454,15 @@ class SimulatedMachine:
         for axis, value in target_mcs.items():
             target[self._kinematics.index(axis)] = finite(value, f"target.{axis}")
         return target
+
+    # --- kinematic data (KinematicData, design.md §10.6) ----------------------------------
+    def kinematic_data(self) -> dict[str, dict[str, list[float]]]:
+        with self._lock:
+            return self._kinematics.nc_lines()
+
+    def write_kinematic_data(self, lines: dict) -> None:
+        with self._lock:
+            self._kinematics.set_nc_lines(lines)
 
     # --- swivel head (SwivelHead) --------------------------------------------------------
     def has_swivel(self) -> bool:
