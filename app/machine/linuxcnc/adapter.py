@@ -72,6 +72,7 @@ from ..protocol import (
     ProbeResult,
 )
 from ..scenario import GEOMETRY_AXES, Scenario
+from ..scene import protection_data
 from .config import COMPONENT, TOOL_TABLE, scenario_tools, tool_table_text
 from .modules import LinuxCncMissing, import_linuxcnc
 from .process import LinuxCncProcess, LinuxCncStartError
@@ -226,6 +227,13 @@ class LinuxCncMachine:
     def scene(self):
         """The truth the probe input is fed from (tests only; the HMI never sees it)."""
         return self._contact.scene
+
+    def protection_model(self) -> dict:
+        """The start guard's model (issue 24 §1), as the simulator's: the generated configuration
+        is commissioned from the scenario, so its scene and limits are this control's protection
+        zones (plain data, MCS)."""
+        limits = {a: [float(lo), float(hi)] for a, (lo, hi) in self._kin.limits.items()}
+        return {"bodies": protection_data(self._contact.scene), "limits": limits}
 
     def _position(self) -> np.ndarray:
         """The joint positions as the servo thread has them now (the comparator's own inputs):
