@@ -97,6 +97,9 @@ class MachineStatus:
     #                                                           horizontal spindle: scenario machine.spindle_axis)
     probe: ProbeState | None = None          # the workpiece probe; None: the controller cannot tell
     tool_probe: ProbeState | None = None     # the tool probe; None: none, or the controller cannot tell
+    # where the control's head kinematics put the spindle nose relative to the X/Y/Z axis position
+    # (MCS, mm; design.md §10.6): 0 for a head turning about the tool reference point, or no head
+    head_shift: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
 @dataclass(frozen=True)
@@ -214,6 +217,18 @@ class SwivelHead(Protocol):
     def retract_tool_axis(self, distance: float | None = None) -> MoveResult: ...
 
     def swivel_to_wcs(self, wcs2bcs_rotation, infeed=(0.0, 0.0, 1.0)) -> MoveResult: ...
+
+
+@runtime_checkable
+class KinematicData(Protocol):
+    """Optional: a control that holds rotary-axis kinematic data (design.md §10.6): the axis lines
+    ``{axis: {"point": [x, y, z], "direction": [dx, dy, dz]}}`` at the zero position of every
+    rotary axis (head axes relative to the tool reference point, a table's in MCS)."""
+
+    def kinematic_data(self) -> dict[str, dict[str, list[float]]]: ...
+
+    def write_kinematic_data(self, lines: dict) -> None:
+        """Replace the lines of the axes given (others keep theirs); ValueError names a bad axis."""
 
 
 @runtime_checkable

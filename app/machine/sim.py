@@ -82,8 +82,10 @@ class SimulatedMachine(SimulatedControl):
             position = self._motion.position
             mcs = self._kinematics.as_dict(position)
             tool_length = self._offset_length if self._tool is not None else 0.0
-            axis = self._kinematics.tool_axis(position)
-            tip_in_mcs = position[XYZ] - tool_length * axis
+            # what the NC computes from its kinematic data (design.md §10.6), not the truth
+            axis = self._kinematics.nc_tool_axis(position)
+            shift = self._kinematics.nc_head_shift(position)
+            tip_in_mcs = position[XYZ] + shift - tool_length * axis
             p_in_wcs = self._bcs2wcs @ np.append(tip_in_mcs, 1.0)
             wcs = {a: float(p_in_wcs[i]) for i, a in enumerate(GEOMETRY_AXES)}
             for a in self.axes[3:]:
@@ -95,6 +97,7 @@ class SimulatedMachine(SimulatedControl):
                 spindle_angle=self._spindle_angle, spindle_speed=self._spindle_speed,
                 busy=self._motion.busy, alarms=self._alarms.shown(),
                 tool_axis=(float(axis[0]), float(axis[1]), float(axis[2])),
+                head_shift=(float(shift[0]), float(shift[1]), float(shift[2])),
                 probe=self._probes.state(WORKPIECE, self._contact.is_probe(self._tool), on_probe),
                 tool_probe=self._probes.state(TOOL, True, on_tool_probe) if self._probes.has(TOOL) else None)
 
@@ -145,6 +148,15 @@ class SimulatedMachine(SimulatedControl):
             return None
         return self._alarms.raise_(Alarm.of(alarms.PROBE_COLLISION, "Probe collision: the swivel "
                                             "would turn the tool into the workpiece"))
+
+    # --- kinematic data (KinematicData, design.md §10.6) ----------------------------------
+    def kinematic_data(self) -> dict[str, dict[str, list[float]]]:
+        with self._lock:
+            return self._kinematics.nc_lines()
+
+    def write_kinematic_data(self, lines: dict) -> None:
+        with self._lock:
+            self._kinematics.set_nc_lines(lines)
 
     # --- swivel head (SwivelHead) --------------------------------------------------------
     def has_swivel(self) -> bool:
