@@ -40,6 +40,7 @@ class ShdrAdapter:
         self._thread: threading.Thread | None = None
         self._stop = threading.Event()
         self._agents: dict[socket.socket, bytearray] = {}       # socket -> bytes received, not yet a line
+        self._waiting: set[socket.socket] = set()     # connected before the first whole state was read
         self._items: dict[str, str] = {}
         self._table = ""
         self._alarms: set[tuple[int, str]] | None = None
@@ -99,7 +100,9 @@ class ShdrAdapter:
         selector.register(agent, selectors.EVENT_READ)
         self._agents[agent] = bytearray()
         log.info("MTConnect agent %s connected", address[0])
-        if self._items:
+        if self._alarms is None:           # nothing read yet: the whole state follows the first read
+            self._waiting.add(agent)
+        else:
             self._send(selector, agent, self._snapshot())
 
     def _receive(self, selector, agent: socket.socket) -> None:
@@ -124,6 +127,7 @@ class ShdrAdapter:
 
     def _drop(self, selector, agent: socket.socket) -> None:
         self._agents.pop(agent, None)
+        self._waiting.discard(agent)
         try:
             selector.unregister(agent)
         except (KeyError, ValueError):
@@ -150,28 +154,30 @@ class ShdrAdapter:
         except Exception as exc:          # a controller or database hiccup must not end the adapter
             log.warning("MTConnect update failed: %s", exc)
             return
-        if changes and self._agents:
-            for agent in list(self._agents):
+        waiting, self._waiting = self._waiting, set()
+        for agent in waiting:
+            self._send(selector, agent, self._snapshot())
+        if changes:
+            for agent in [a for a in self._agents if a not in waiting]:
                 self._send(selector, agent, changes)
 
     def _read(self) -> str:
-        """Reads the services and returns the SHDR lines of what changed ('' for nothing)."""
+        """Reads the services and returns the SHDR lines of what changed ('' for nothing). Everything
+        is read before anything is kept, so a failed read leaves the last whole state as it was."""
         status = self._services.machine.status()
-        now = timestamp()
         items = samples(status)
+        alarms = {(int(a["code"]), str(a["text"])) for a in status["alarms"]}
+        generation = self._services.db.generation
+        table = self._table
+        if generation != self._generation:
+            table = offsets_table(self._services.offsets.list())
+        now = timestamp()
         changed = {k: v for k, v in items.items() if self._items.get(k) != v}
         changed |= {k: UNAVAILABLE for k in self._items if k not in items}    # an axis the machine lost
-        self._items = items
         lines = [now + "|" + "|".join(f"{k}|{v}" for k, v in changed.items())] if changed else []
-        alarms = {(int(a["code"]), str(a["text"])) for a in status["alarms"]}
         if self._alarms is not None and alarms != self._alarms:
             lines += [f"{now}|{line}" for line in conditions(alarms, self._alarms)]
-        self._alarms = alarms
-        generation = self._services.db.generation
-        if generation != self._generation:
-            self._generation = generation
-            table = offsets_table(self._services.offsets.list())
-            if table != self._table:
-                self._table = table
-                lines.append(f"{now}|woffsets|{table}")
+        if table != self._table:
+            lines.append(f"{now}|woffsets|{table}")
+        self._items, self._alarms, self._generation, self._table = items, alarms, generation, table
         return "\n".join(lines) + "\n" if lines else ""

@@ -61,7 +61,8 @@ def test_the_planned_path_before_nc_start_and_the_touch_after(probing):
     assert start == pytest.approx([FACE_X - 20.0, 200.0, BLOCK_TOP_Z - 10.0])
     direction = (end - start) / np.linalg.norm(end - start)
     assert direction == pytest.approx([1.0, 0.0, 0.0])              # X+, at the probe's height
-    assert end[0] > FACE_X - BALL_R                                  # the path reaches the face
+    # the start guard's model ends the stroke where the ball first touches the face, a contact
+    assert end[0] == pytest.approx(FACE_X - BALL_R, abs=1e-6) and probe_moves[0]["verdict"] == "contact"
 
     assert probing.post(f"/api/measure/{session['id']}/start").status_code == 200
     after = scene(probing)

@@ -4,13 +4,17 @@ connect, equal to the JSON API, a jog within a second, the heartbeat, alarms as 
 from __future__ import annotations
 
 import socket
+import threading
 import time
+from types import SimpleNamespace
 
 import httpx
 import pytest
 from hmi_testdata import TEST_SCENARIO
 from live import free_port, serve
+from waiting import wait_until
 
+from app.mtconnect.adapter import ShdrAdapter
 from app.mtconnect.items import conditions, offsets_table
 
 
@@ -20,6 +24,9 @@ def shdr(tmp_path_factory):
     with serve(tmp_path_factory.mktemp("mtconnect"), TEST_SCENARIO, settings={"mtconnect_port": port}) as url:
         with httpx.Client(base_url=url, timeout=10) as http:
             yield http, port
+
+
+WHOLE_STATE = {"avail", "mode", "execution", "Xact", "system", "woffsets"}   # a few of each kind of line
 
 
 class Agent:
@@ -68,7 +75,7 @@ def test_an_agent_gets_the_state_of_the_json_api_and_a_jog_within_a_second(shdr)
     http, port = shdr
     agent = Agent(port)
     try:
-        agent.read_until(lambda: "woffsets" in agent.values and "Xact" in agent.values)
+        agent.read_until(lambda: WHOLE_STATE <= agent.values.keys())
         machine = http.get("/api/machine").json()
         for axis, value in machine["mcs"].items():
             assert float(agent.values[f"{axis}act"]) == pytest.approx(value, abs=1e-4)
@@ -80,6 +87,46 @@ def test_an_agent_gets_the_state_of_the_json_api_and_a_jog_within_a_second(shdr)
         agent.read_until(lambda: abs(float(agent.values["Yact"]) - target) < 1e-4, timeout_s=5.0)
     finally:
         agent.close()
+
+
+class _Stalling:
+    """Services whose machine cannot be read until ``ready`` is set (a controller still starting):
+    counts the reads, so a test knows the adapter went round its loop."""
+
+    def __init__(self):
+        self.ready = threading.Event()
+        self.reads = 0
+        self.machine = self
+        self.offsets = self
+        self.db = SimpleNamespace(generation=1)
+
+    def status(self) -> dict:
+        self.reads += 1
+        if not self.ready.is_set():
+            raise ConnectionError("controller not up yet")
+        return {"mode": "JOG", "program_state": "reset", "mcs": {"X": 1.0}, "wcs": {"X": 1.0},
+                "feed_override": 100.0, "tool": None, "active_offset": "G54",
+                "alarms": [{"code": 61302, "text": "collision"}]}
+
+    def list(self) -> dict:
+        return {"G54": {"trans": {"X": 2.0}}}
+
+
+def test_an_agent_that_connects_before_the_first_read_gets_the_whole_state():
+    services = _Stalling()
+    adapter = ShdrAdapter(services, "127.0.0.1", free_port())
+    adapter.start()
+    try:
+        agent = Agent(adapter._port)
+        reads = services.reads
+        wait_until(lambda: services.reads >= reads + 2, "the adapter's loop went round (accepting the agent)")
+        services.ready.set()
+        agent.read_until(lambda: WHOLE_STATE <= agent.values.keys())
+        assert agent.values["system"].startswith("FAULT|61302|")
+        assert agent.values["woffsets"] == "G54={X=2.0000}" and agent.values["Xact"] == "1.0000"
+        agent.close()
+    finally:
+        adapter.stop()
 
 
 def test_the_heartbeat_is_answered(shdr):
