@@ -37,6 +37,7 @@ Decisions (where the spec leaves room):
 from __future__ import annotations
 
 import threading
+from typing import Any
 
 import numpy as np
 
@@ -456,7 +457,7 @@ class SimulatedMachine:
         return target
 
     # --- kinematic data (KinematicData, design.md §10.6) ----------------------------------
-    def kinematic_data(self) -> dict[str, dict[str, list[float]]]:
+    def kinematic_data(self) -> dict[str, dict[str, Any]]:
         with self._lock:
             return self._kinematics.nc_lines()
 
