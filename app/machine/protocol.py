@@ -253,11 +253,3 @@ class SimulatorControl(Protocol):
         """The operator's hand on probe ``which`` ("workpiece", "tool"): deflect or release it,
         change the battery, switch a radio probe on or off (design.md §10.4). ValueError names
         the field."""
-
-
-def add_alarm_once(alarms_shown: list[Alarm], alarm: Alarm) -> Alarm:
-    """Append ``alarm`` to a controller's shown alarms unless the same one is shown already (the
-    caller holds its lock); returns it. Shared by every Machine implementation."""
-    if all(a.code != alarm.code or a.text != alarm.text for a in alarms_shown):
-        alarms_shown.append(alarm)
-    return alarm
