@@ -187,7 +187,19 @@ class SpindleStep:
     label: str = ""
 
 
-Step = MoveStep | ProbeStep | SpindleStep
+@dataclass(frozen=True)
+class RotaryStep:
+    """Positioning of rotary axes (deg, rapid; design.md §10.6): a swivel head or a rotary table.
+    A head axis turns the NC's tool axis, so the tip <-> axes conversion is taken anew after it.
+    ``tip`` (MCS, only for a step to the zero position of every rotary axis): X/Y/Z move in the
+    same motion so that the NC's tool reference ends there (L along the spindle axis)."""
+
+    axes: tuple[tuple[str, float], ...]
+    label: str = ""
+    tip: FloatArray | None = None
+
+
+Step = MoveStep | ProbeStep | SpindleStep | RotaryStep
 
 
 @dataclass(frozen=True)

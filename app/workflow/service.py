@@ -112,6 +112,10 @@ class WorkflowService:
             normalised, chosen = self._params_with_target(spec, params, target, ctx)
         else:
             normalised = self._validate(spec, params, ctx)
+            try:
+                spec.check_machine(normalised, self._env)
+            except ValueError as exc:
+                raise WorkflowError(400, "invalid_param", str(exc), getattr(exc, "field", None)) from exc
             self._check_rotary_axis(normalised)
             chosen = target or ctx.active_offset
             if chosen == "G500" and spec.corrects_zero_offset:
