@@ -52,7 +52,7 @@ from app.records import PROBE_TOOL_TYPE
 from db import Database
 from engine.alarms import all_alarms
 from engine.alarms import by_number as alarm_by_number
-from engine.coords import GEOMETRY_AXES, LatheToolTip, ToolTip, length_axis
+from engine.coords import GEOMETRY_AXES, LatheToolTip, ToolTip, head_shift_of, length_axis
 from engine.frames import G500, Frame, FrameChain, chain_of, is_basic
 from engine.planes import plane as plane_by_name
 
@@ -154,6 +154,7 @@ class MachineService:
     def status(self) -> dict:
         """The ``GET /api/machine`` body (design.md §4) plus channel, tool length, program state."""
         st = self._machine.status()
+        settings = self._settings.get()
         alarms = [alarm_dict(a) for a in st.alarms]
         program_state = "active" if st.busy else ("interrupted" if alarms else "reset")
         return {
@@ -162,7 +163,8 @@ class MachineService:
             "mcs": {a: float(v) for a, v in st.mcs.items()},
             "wcs": self.wcs_from_mcs(st.mcs, st.tool_length),
             "active_offset": self._active_offset,
-            "plane": self._settings.get().plane,
+            "plane": settings.plane,
+            "units": settings.units,        # the screens' units (design.md §9.9): the live feed carries a change
             "tool": st.tool,
             "tool_length": float(st.tool_length),
             "feed_override": float(st.feed_override),
@@ -173,6 +175,7 @@ class MachineService:
             "lock": self.lock_source() if self.lock_source else None,
             "program_state": program_state,
             "tool_axis": [float(v) for v in getattr(st, "tool_axis", (0.0, 0.0, 1.0))],
+            "head_shift": [float(v) for v in head_shift_of(getattr(st, "head_shift", None))],
             "swivel": self.has_swivel(),
             "controller": self._machine.controller,
             # design.md §10.7: the controller's E-stop and drives, and the machine's own INI (LinuxCNC)
@@ -255,7 +258,7 @@ class MachineService:
         if tool_length is None:
             tool_length = st.tool_length
         axis = length_axis(getattr(st, "tool_axis", None), self.plane().infeed_unit)
-        return ToolTip(self._chain.wcs2bcs, float(tool_length), axis)
+        return ToolTip(self._chain.wcs2bcs, float(tool_length), axis, head_shift_of(getattr(st, "head_shift", None)))
 
     def wcs_from_mcs(self, mcs: Mapping[str, float], tool_length: float | None = None) -> dict[str, float]:
         p_wcs = self._tip(tool_length).tip_in_wcs([float(mcs.get(a, 0.0)) for a in GEOMETRY_AXES])

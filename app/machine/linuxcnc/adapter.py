@@ -57,6 +57,7 @@ import numpy as np
 
 from engine import alarms
 
+from ..alarm_book import AlarmBook
 from ..checks import finite, positive
 from ..contact import Contact, Event
 from ..kinematics import Kinematics
@@ -69,7 +70,6 @@ from ..protocol import (
     MachineStatus,
     MoveResult,
     ProbeResult,
-    add_alarm_once,
 )
 from ..scenario import GEOMETRY_AXES, Scenario
 from ..scene import protection_data
@@ -138,7 +138,7 @@ class LinuxCncMachine:
         self._abort = threading.Event()
         self._stop = threading.Event()
         self._jog: tuple[int, threading.Thread] | None = None
-        self._alarms: list[Alarm] = []
+        self._alarms = AlarmBook(self._lock)      # shown alarms (alarm_book.py, shared with the simulators)
         self._messages: list[tuple[int, str]] = []
         self._nc = NcData(GEOMETRY_AXES)
         self._tools = scenario_tools(scenario)
@@ -325,21 +325,17 @@ class LinuxCncMachine:
                 mcs=self._kin.as_dict(position), wcs={a: float(p_wcs[i]) for i, a in enumerate(GEOMETRY_AXES)},
                 active_offset=self._frame.name, tool=self._tool, tool_length=float(length),
                 feed_override=float(self._override), spindle_angle=float(self._spindle_angle),
-                spindle_speed=float(speed) if speed else 0.0, busy=self._busy, alarms=tuple(self._alarms),
+                spindle_speed=float(speed) if speed else 0.0, busy=self._busy, alarms=self._alarms.shown(),
                 estop=bool(estop), machine_on=bool(machine_on))
 
     def post_alarm(self, alarm: Alarm) -> None:
         self._raise(alarm)
 
     def _raise(self, alarm: Alarm) -> Alarm:
-        with self._lock:
-            return add_alarm_once(self._alarms, alarm)
-
-    def _broken(self) -> Alarm | None:
-        return next((a for a in self._alarms if a.is_(alarms.PROBE_BROKEN)), None)
+        return self._alarms.raise_(alarm)
 
     def _break_probe(self) -> Alarm:
-        return self._raise(Alarm.of(alarms.PROBE_BROKEN, "Probe broken: overtravel beyond the permissible deflection"))
+        return self._alarms.break_probe()
 
     def _controller_alarm(self, errors: list[str]) -> Alarm:
         """The catalogue entry for LinuxCNC's error messages (the first that names one)."""
@@ -359,9 +355,7 @@ class LinuxCncMachine:
             if self._busy:
                 raise MachineBusy("a motion is already running")
             if may_move:
-                broken = self._broken()
-                if broken is not None:
-                    raise MachineAlarm(broken)
+                self._alarms.refuse_if_broken()
             self._busy = True
             self._abort.clear()
             self._stop.clear()
@@ -704,8 +698,7 @@ class LinuxCncMachine:
             self._cmd.wait_complete(2.0)
         self._wait_idle()
         self._drain()
-        with self._lock:
-            self._alarms = [a for a in self._alarms if not a.resettable]
+        self._alarms.reset()
 
     def probe(self, direction, distance: float, feed: float) -> ProbeResult:
         """G38.3 along ``direction``; the result is the comparator's latch (the generated
@@ -809,8 +802,7 @@ class LinuxCncMachine:
             self._setup(f"G43.1 Z{_num(offset_length)}" if tool is not None else "G49")
             with self._lock:
                 self._tool, self._offset_length = tool, offset_length
-                broken = self._broken()
-                self._alarms = [a for a in self._alarms if a is not broken]
+                self._alarms.repair_probe()
 
         self._quiet(change)
 
