@@ -35,4 +35,8 @@ fi
 .venv/bin/mypy
 # import contracts (.importlinter): the layers of design.md §2 and no cycles, function-level imports included
 .venv/bin/lint-imports --no-cache >/dev/null || .venv/bin/lint-imports --no-cache
-exec .venv/bin/python -m pytest "$@"
+if [ "$#" -gt 0 ]; then exec .venv/bin/python -m pytest "$@"; fi
+.venv/bin/python -m pytest
+# the plant mode (docs/plant.md): the database, migration, concurrency and plant tests again on
+# PostgreSQL, in a private cluster the tests start and stop (tests/pgcluster.py)
+exec .venv/bin/python -m pytest --db-engine=postgresql tests/db tests/plant
