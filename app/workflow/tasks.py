@@ -360,7 +360,7 @@ class KinematicsTaskSpec(TaskSpec):
     guarded = False
 
     def points_of(self, params: dict) -> int:
-        return len(params["positions"])
+        return len(params["positions"]) + (1 if "_reference" in params else 0)
 
     def coords_for(self, params: dict, plan_ctx) -> str:
         return "MCS"
@@ -377,7 +377,10 @@ class KinematicsTaskSpec(TaskSpec):
         return 1
 
     def check_machine(self, params: dict, env) -> None:
-        kinematics_task.check_machine(params, env.measuring_context().extra.get("kinematics") or {})
+        facts = env.measuring_context().extra.get("kinematics") or {}
+        kinematics_task.check_machine(params, facts)
+        if kinematics_task.partner_of(params, facts) is not None:
+            params["_reference"] = True        # P(n+1): the sphere with every rotary axis at 0
 
 
 KINEMATICS_SPEC = KinematicsTaskSpec(kinematics_task.ENGINE_TASK, Category.WORKPIECE, frozenset(),
