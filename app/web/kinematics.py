@@ -10,7 +10,7 @@ import math
 from fastapi import APIRouter, Request
 
 from app.access.deps import needs
-from app.deps import ServicesDep
+from app.deps import ServicesDep, WorkflowDep
 from app.errors import HmiError
 from app.i18n import _
 from app.services.kinematics import KinematicsService
@@ -75,10 +75,9 @@ async def redraw(request: Request, services: ServicesDep):
 
 
 @router.post("/kinematics/measure", name="kinematics_measure", dependencies=[needs("measure")])
-async def measure(request: Request, services: ServicesDep):
+async def measure(request: Request, services: ServicesDep, workflow: WorkflowDep):
     """All positions one after the other, then Calculate (in ``optimise`` the screen asked first)."""
     form = {k: str(v) for k, v in (await request.form()).items() if k != "csrf_token"}
-    workflow = services.workflow
     try:
         params = _params(form)
         session = workflow.create(TASK, params)
