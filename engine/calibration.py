@@ -53,7 +53,7 @@ from engine.planes import PLANES, Plane, axis_index
 from engine.types import EdgePoint, FloatArray, MeasuringError, ProbeRecord
 
 __all__ = ["PRETRAVEL_FRAMES", "FrameDecision", "RingEstimate", "RingTouch", "calibrate_length",
-           "calibrate_length_point", "calibrate_radius", "calibrate_ring", "calibration_jacobian",
+           "calibrate_length_point", "calibrate_radius", "calibrate_surface", "calibrate_ring", "calibration_jacobian",
            "calibration_variances", "choose_pretravel_frame", "estimate_ring", "evaluate_probe_task",
            "ideal_ring_touches", "probe_values", "ring_touches", "setup_noise_bound"]
 
@@ -98,6 +98,46 @@ def calibrate_length_point(point: EdgePoint, setpoint: float, probe: ProbeRecord
     if probe.length_to_tip:
         rec = rec - (probe.ball_diameter / 2.0) * p          # back to the tip (jog-measuring §0.1)
     return calibrate_length(float(rec @ p), setpoint, probe, length_old, plane)
+
+
+def calibrate_surface(point: EdgePoint, axis: str, setpoint: float, probe: ProbeRecord, *,
+                      safe_area: float | None = None) -> tuple[ProbeRecord, dict[str, Any]]:
+    """Trigger value of one direction on a surface at ``setpoint`` (CYCLE976 ``_MVAR=0``,
+    manual §5.3.3 ``%_N_KALIBRIEREN_IN_Z_MPF``, measuring-math §5.1, measuring-math §7.5).
+
+    ``point``: one touch travelling along ±``axis`` (``touch.ball_centre`` = c = rec + e, the
+    ball-centre estimate with the stored skew, + r·p̂ with L1 to the tip). The probe length L1 is
+    known and stays; only the travel direction's trigger value changes:
+
+        t_dir = c_axis − _SETVAL          (measuring-math §7.5; ideal probe t(−) = +r, t(+) = −r)
+
+    ``safe_area`` (_TSA): |t_new − t_old| above it refuses with 61303 (the manual's advice for a
+    first calibration: program _TSA greater than the ball radius). A trigger value of the wrong
+    sign (the surface lies behind the switching point) is 61303 as well.
+    """
+    touch = point.touch
+    d = np.asarray(touch.direction, dtype=float)
+    j = axis_index(axis)
+    if abs(abs(float(d[j])) - 1.0) > 1e-9:
+        raise ValueError(f"the surface touch must travel along {axis}, got direction {d.tolist()}")
+    sign = "+" if d[j] > 0.0 else "-"
+    key = f"{axis}{sign}"
+    trigger = float(np.asarray(touch.ball_centre, dtype=float)[j]) - float(setpoint)   # measuring-math §7.5
+    if trigger == 0.0 or (trigger < 0.0) != (sign == "+"):
+        raise MeasuringError(alarms.SAFE_AREA, f"trigger value {key} = {trigger:.4f} has the wrong sign: "
+                                               f"check _SETVAL = {setpoint:g}")
+    old = probe.trigger.get(key)
+    difference = None if old is None else trigger - float(old)
+    if safe_area is not None and abs(trigger - float(old or 0.0)) > safe_area:
+        raise MeasuringError(alarms.SAFE_AREA, f"trigger value {key} = {trigger:.4f} differs by "
+                                               f"{abs(trigger - float(old or 0.0)):.4f} mm from the stored "
+                                               f"{float(old or 0.0):.4f}: more than _TSA = {safe_area:g}")
+    triggers = dict(probe.trigger)
+    triggers[key] = trigger
+    record = replace(probe, trigger=triggers)
+    values = {"trigger": {key: trigger}, "trigger_difference": {key: difference},
+              "surface": {axis: float(setpoint)}}
+    return record, values
 
 
 def _pass_mid(ring_pass: RingPass, axis: str) -> tuple[float, float, float]:

@@ -10,7 +10,7 @@ axis. Names carry the direction (``tip_in_wcs``, ``axes_for_tip``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import numpy.typing as npt
@@ -18,7 +18,7 @@ import numpy.typing as npt
 from engine.frames import GEOMETRY_AXES, Frame
 from engine.types import FloatArray
 
-__all__ = ["GEOMETRY_AXES", "LatheToolTip", "ToolTip", "length_axis"]
+__all__ = ["GEOMETRY_AXES", "LatheToolTip", "ToolTip", "head_shift_of", "length_axis"]
 _Z = np.array([0.0, 0.0, 1.0])
 
 
@@ -32,6 +32,12 @@ def length_axis(tool_axis: npt.ArrayLike | None, infeed_unit: npt.ArrayLike) -> 
     return np.asarray(infeed_unit, dtype=float)
 
 
+def head_shift_of(head_shift: npt.ArrayLike | None) -> FloatArray:
+    """The status' ``head_shift`` as a (3,) vector, 0 when the controller reports none."""
+    shift = np.zeros(3) if head_shift is None else np.asarray(head_shift, dtype=float)
+    return shift if shift.shape == (3,) else np.zeros(3)
+
+
 @dataclass(frozen=True)
 class ToolTip:
     """The conversions of one measuring chain and one tool (``coords`` "WCS" or "MCS")."""
@@ -39,12 +45,16 @@ class ToolTip:
     wcs2bcs: Frame              # measuring chain, BCS = MCS
     tool_length: float          # the NC's offset length L1 of the active tool
     tool_axis_mcs: FloatArray   # unit vector from tool tip to spindle (``length_axis``)
+    # spindle nose minus X/Y/Z axis position by the control's head kinematics (design.md §10.6):
+    # a head whose axes do not pass through the tool reference point moves the nose as it turns
+    head_shift: FloatArray = field(default_factory=lambda: np.zeros(3))
 
     def tip_in_mcs(self, axes_mcs: npt.ArrayLike) -> FloatArray:
-        return np.asarray(axes_mcs, dtype=float) - self.tool_length * self.tool_axis_mcs
+        """tip = A + shift − L·axis (the TRAORI-like forward transform of the NC's kinematic data)."""
+        return np.asarray(axes_mcs, dtype=float) + self.head_shift - self.tool_length * self.tool_axis_mcs
 
     def axes_for_tip_mcs(self, tip_mcs: npt.ArrayLike) -> FloatArray:
-        return np.asarray(tip_mcs, dtype=float) + self.tool_length * self.tool_axis_mcs
+        return np.asarray(tip_mcs, dtype=float) - self.head_shift + self.tool_length * self.tool_axis_mcs
 
     def tip_in_wcs(self, axes_mcs: npt.ArrayLike) -> FloatArray:
         return self.wcs2bcs.parent2child(self.tip_in_mcs(axes_mcs))

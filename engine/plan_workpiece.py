@@ -90,6 +90,24 @@ def edge_program(d: FloatArray, start: FloatArray, ctx: PlanContext, label: str,
                                 latched_mcs=latch.latched_mcs))
 
 
+def surface_program(d: FloatArray, setpoint: float, start: FloatArray, ctx: PlanContext, label: str,
+                    stay: bool) -> Program[EdgePoint]:
+    """CYCLE976 ``_MVAR=0`` (manual §5.3.3, measuring-math §7.5): along the travel d (± one axis)
+    to ``_FA`` in front of the surface at ``setpoint`` (ball surface, nominal radius), probe over
+    2·_FA, then back: to that place (``stay``: _MA=3, "the ball _FA from the surface") or to the
+    start (_MA=1/2). ``touch.ball_centre`` = c = rec + e (stored skew)."""
+    m = Motion(start, ctx)
+    j = int(np.argmax(np.abs(d)))
+    before = m.start.copy()
+    before[j] = setpoint - float(d[j]) * (ctx.probe.ball_diameter / 2.0 + ctx.measuring_path)
+    yield from m.move(before, f"{label} approach")
+    latch = yield from m.probe(d, 2.0 * ctx.measuring_path, label, expected=ctx.measuring_path)
+    yield from m.back(before if stay else m.start)
+    return EdgePoint(make_touch(latch.rec, d, ctx.probe, ctx.plane, skew_wcs=ctx.skew_wcs,
+                                spindle_angle=ctx.spindle_angle, wcs2bcs=ctx.wcs2bcs,
+                                latched_mcs=latch.latched_mcs))
+
+
 # --- inner features: hole, rectangular pocket, ring gauge -------------------------------------
 
 def _inner_chord(m: Motion, centre: FloatArray, d: FloatArray, reach: float | None,

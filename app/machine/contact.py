@@ -196,7 +196,8 @@ class Contact:
                 hit = self.ball_in_solid(pose, spindle_angle)
             else:
                 cutter = self._cutter(tool)
-                end = pose[:3] - (cutter.length - cutter.radius) * self._kinematics.tool_axis(pose)
+                end = (pose[:3] + self._kinematics.head_shift(pose)
+                       - (cutter.length - cutter.radius) * self._kinematics.tool_axis(pose))
                 hit = self._scene.subset(OBSTACLES).sdf(end) < cutter.radius
             if hit:
                 return True

@@ -26,13 +26,15 @@ Decisions (where the spec leaves room):
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
 from engine import alarms
 
-from .physics import SPINDLE_MOUNTS, Z_UNIT, ball_centre, head_rotation, probe_rotation
-from .physics import head_angles_for as head_angle_candidates
+from .axis_lines import Line, as_line, head_transform
+from .axis_lines import head_angles_for as head_angle_candidates
+from .physics import SPINDLE_MOUNTS, Z_UNIT, ball_centre, probe_rotation
 from .protocol import Alarm
 from .scenario import GEOMETRY_AXES, Scenario, SwivelHead, Tool
 
@@ -50,6 +52,16 @@ class Kinematics:
         axis = scenario.machine.spindle_axis
         self.spindle_axis: str = axis
         self._mount: np.ndarray | None = None if axis == "Z" else SPINDLE_MOUNTS[axis]
+        head = scenario.machine.kinematics
+        # the head's axis lines (design.md §10.6): the truth moves the ball, the NC's (its machine
+        # data, nominal until written) compute the tool axis, the swivel angles and the display
+        self._true_lines: dict[str, Line] = {} if head is None else \
+            {a: as_line(line) for a, line in head.true_lines().items()}
+        self._nc_lines: dict[str, Line] = {} if head is None else \
+            {a: as_line(line) for a, line in head.nominal_lines().items()}
+        table = scenario.machine.rotary_table        # the part follows the table's true line (scene.py)
+        self._nc_table: dict[str, Line] = {} if table is None else \
+            {a: as_line(line) for a, line in table.nominal_lines().items()}
 
     # --- axis positions ------------------------------------------------------------------
     def index(self, axis: str) -> int:
@@ -88,13 +100,51 @@ class Kinematics:
         return float(position[self.axes.index(table.axis)])
 
     # --- the tool ------------------------------------------------------------------------
-    def head(self, position: np.ndarray) -> np.ndarray | None:
-        """R_head at the axis ``position`` (None without a swivel head)."""
+    def _head_transform(self, position: np.ndarray, lines: dict[str, Line]) -> tuple[np.ndarray, np.ndarray] | None:
         swivel = self._swivel()
         if swivel is None:
             return None
         head_axes = swivel.axes
-        return head_rotation(head_axes, [position[self.axes.index(a)] for a in head_axes])
+        return head_transform(lines, head_axes, [position[self.axes.index(a)] for a in head_axes])
+
+    def head(self, position: np.ndarray) -> np.ndarray | None:
+        """The true R_head at the axis ``position`` (None without a swivel head)."""
+        moved = self._head_transform(position, self._true_lines)
+        return None if moved is None else moved[0]
+
+    def head_shift(self, position: np.ndarray) -> np.ndarray:
+        """Where the true head kinematics move the spindle nose from the X/Y/Z axis position (MCS)."""
+        moved = self._head_transform(position, self._true_lines)
+        return np.zeros(3) if moved is None else moved[1]
+
+    # --- the control's kinematic data (machine data, design.md §10.6) ---------------------
+    def nc_lines(self) -> dict[str, dict[str, Any]]:
+        """The axis lines the NC holds (head and table), ``{axis: {"point", "direction", "unit"}}``."""
+        units = {**{a: "head" for a in self._nc_lines}, **{a: "table" for a in self._nc_table}}
+        return {a: {"point": [float(v) for v in p], "direction": [float(v) for v in d], "unit": units[a]}
+                for a, (p, d) in {**self._nc_lines, **self._nc_table}.items()}
+
+    def set_nc_lines(self, lines: dict) -> None:
+        """Replace NC axis lines (axes not given keep theirs); ValueError names a bad axis."""
+        known = set(self._nc_lines) | set(self._nc_table)
+        unknown = set(lines) - known
+        if unknown:
+            raise ValueError(f"kinematics: {sorted(unknown)} has no kinematic data on this machine "
+                             f"(its rotary units: {sorted(known)})")
+        converted = {a: as_line(line) for a, line in lines.items()}
+        self._nc_lines = {**self._nc_lines, **{a: v for a, v in converted.items() if a in self._nc_lines}}
+        self._nc_table = {**self._nc_table, **{a: v for a, v in converted.items() if a in self._nc_table}}
+
+    def nc_tool_axis(self, position: np.ndarray) -> np.ndarray:
+        """The tool axis as the NC computes it from its kinematic data."""
+        moved = self._head_transform(position, self._nc_lines)
+        axis = Z_UNIT.copy() if self._mount is None else self._mount @ Z_UNIT
+        return axis if moved is None else moved[0] @ axis
+
+    def nc_head_shift(self, position: np.ndarray) -> np.ndarray:
+        """Where the NC's kinematic data put the spindle nose relative to the X/Y/Z axis position."""
+        moved = self._head_transform(position, self._nc_lines)
+        return np.zeros(3) if moved is None else moved[1]
 
     @property
     def mount(self) -> np.ndarray:
@@ -110,8 +160,8 @@ class Kinematics:
     def ball_centre(self, position: np.ndarray, spindle_angle: float) -> np.ndarray:
         """The true ball centre with the axes at ``position`` (physics.ball_centre, this probe and head)."""
         probe = self._scenario.probe
-        return ball_centre(position[XYZ], probe.length, probe.eccentricity, spindle_angle, self.head(position),
-                           self._mount)
+        return ball_centre(position[XYZ] + self.head_shift(position), probe.length, probe.eccentricity,
+                           spindle_angle, self.head(position), self._mount)
 
     def probe_rotation(self, position: np.ndarray, spindle_angle: float) -> np.ndarray:
         """Probe frame -> MCS at ``position`` and SPOS ``spindle_angle`` (physics.probe_rotation)."""
@@ -119,7 +169,7 @@ class Kinematics:
 
     def cutter_tip(self, position: np.ndarray, cutter: Tool) -> np.ndarray:
         """Centre of the cutter's flat end: ``length`` below the spindle nose along the tool axis."""
-        return position[XYZ] - cutter.length * self.tool_axis(position)
+        return position[XYZ] + self.head_shift(position) - cutter.length * self.tool_axis(position)
 
     # --- swivel head (scenario.SwivelHead) -----------------------------------------------
     def _swivel(self) -> SwivelHead | None:
@@ -147,7 +197,7 @@ class Kinematics:
         head_axes = self.head_axes()
         current = [float(position[self.axes.index(a)]) for a in head_axes]
         best = None
-        for cand in head_angle_candidates(head_axes, tool_axis, current):
+        for cand in head_angle_candidates(self._nc_lines, head_axes, tool_axis, current):
             shifted: list[float] = []
             for axis, value, now in zip(head_axes, cand, current, strict=True):
                 lo, hi = self.limits[axis]
@@ -168,8 +218,8 @@ class Kinematics:
         return {a: float(v) for a, v in zip(head_axes, best[1], strict=True)}
 
     def retract_target(self, position: np.ndarray, distance: float | None) -> dict[str, float]:
-        """X/Y/Z ``distance`` up along the tool axis (default: as far as the X/Y/Z limits allow)."""
-        axis = self.tool_axis(position)
+        """X/Y/Z ``distance`` up along the NC's tool axis (default: as far as the X/Y/Z limits allow)."""
+        axis = self.nc_tool_axis(position)
         xyz = position[XYZ]
         s_max = math.inf
         for i, name in enumerate(GEOMETRY_AXES):

@@ -11,7 +11,7 @@ tool reference point (spindle nose). Probing directions are unit vectors in MCS.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Protocol, runtime_checkable
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -97,6 +97,11 @@ class MachineStatus:
     #                                                           horizontal spindle: scenario machine.spindle_axis)
     probe: ProbeState | None = None          # the workpiece probe; None: the controller cannot tell
     tool_probe: ProbeState | None = None     # the tool probe; None: none, or the controller cannot tell
+    estop: bool = False                      # the controller's emergency stop is active (design.md §10.7)
+    machine_on: bool = True                  # the drives are on (LinuxCNC: task state ON)
+    # where the control's head kinematics put the spindle nose relative to the X/Y/Z axis position
+    # (MCS, mm; design.md §10.6): 0 for a head turning about the tool reference point, or no head
+    head_shift: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
 @dataclass(frozen=True)
@@ -217,6 +222,18 @@ class SwivelHead(Protocol):
 
 
 @runtime_checkable
+class KinematicData(Protocol):
+    """Optional: a control that holds rotary-axis kinematic data (design.md §10.6): the axis lines
+    ``{axis: {"point": [x, y, z], "direction": [dx, dy, dz]}}`` at the zero position of every
+    rotary axis (head axes relative to the tool reference point, a table's in MCS)."""
+
+    def kinematic_data(self) -> dict[str, dict[str, Any]]: ...
+
+    def write_kinematic_data(self, lines: dict) -> None:
+        """Replace the lines of the axes given (others keep theirs); ValueError names a bad axis."""
+
+
+@runtime_checkable
 class SimulatorControl(Protocol):
     """Only the simulator offers these: its truth (never used for measuring), scenario load and
     the time scale. The HMI asks ``isinstance(machine, SimulatorControl)`` before using them."""
@@ -238,11 +255,3 @@ class SimulatorControl(Protocol):
         """The operator's hand on probe ``which`` ("workpiece", "tool"): deflect or release it,
         change the battery, switch a radio probe on or off (design.md §10.4). ValueError names
         the field."""
-
-
-def add_alarm_once(alarms_shown: list[Alarm], alarm: Alarm) -> Alarm:
-    """Append ``alarm`` to a controller's shown alarms unless the same one is shown already (the
-    caller holds its lock); returns it. Shared by every Machine implementation."""
-    if all(a.code != alarm.code or a.text != alarm.text for a in alarms_shown):
-        alarms_shown.append(alarm)
-    return alarm

@@ -7,6 +7,7 @@ mm/min, s. Every field has a default except the ones that define a feature's siz
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Annotated, Literal, TypeVar
 
@@ -43,15 +44,61 @@ def _check_range(value: tuple[float, float], name: str) -> tuple[float, float]:
     return value
 
 
+class AxisLine(_Model):
+    """A rotary axis as a line in the machine frame at the zero position of every rotary axis
+    (design.md §10.6): ``point`` on it (mm; relative to the tool reference point for head axes,
+    MCS for a table) and its ``direction`` (any length > 0, normalised here). The axis turns
+    right-handed about ``direction`` (a table: the part by −angle, DIN 66217)."""
+
+    point: Vec3 = (0.0, 0.0, 0.0)
+    direction: Vec3 = (0.0, 0.0, 1.0)
+
+    @field_validator("direction")
+    @classmethod
+    def _unit(cls, value: tuple[float, float, float]) -> tuple[float, float, float]:
+        norm = math.sqrt(sum(v * v for v in value))
+        if not norm > 1e-9:
+            raise ValueError("direction: must not be the zero vector")
+        return (value[0] / norm, value[1] / norm, value[2] / norm)
+
+
+AxisLines = dict[str, AxisLine]        # keys: the unit's axes (checked by _check_lines)
+AXIS_UNITS = {"A": (1.0, 0.0, 0.0), "B": (0.0, 1.0, 0.0), "C": (0.0, 0.0, 1.0)}
+
+
+def _check_lines(lines: dict, axes: tuple[str, ...], field: str) -> None:
+    for name in lines:
+        if name not in axes:
+            raise ValueError(f"{field}: {name!r} is not one of this unit's axes {list(axes)}")
+
+
 class RotaryTable(_Model):
     """A rotary table: the workpiece turns with ``axis`` about a vertical line through ``center``.
 
     ``workpiece.pose`` is the part at axis position 0. DIN 66217: the table turning + turns the
     part clockwise seen from above (the tool's motion relative to the part is right-handed).
+    Kinematic data (design.md §10.6): ``nominal`` is what the control holds (default: the vertical
+    line through ``center``), ``true`` the simulator's real axis line (default: the nominal).
     """
 
     axis: Literal["A", "B", "C"] = "C"
     center: Vec2 = (0.0, 0.0)
+    nominal: AxisLines | None = None
+    true: AxisLines | None = None
+
+    @model_validator(mode="after")
+    def _lines(self) -> RotaryTable:
+        for field, lines in (("rotary_table.nominal", self.nominal), ("rotary_table.true", self.true)):
+            _check_lines(lines or {}, (self.axis,), field)
+        return self
+
+    def nominal_lines(self) -> dict[str, AxisLine]:
+        ideal = AxisLine(point=(self.center[0], self.center[1], 0.0), direction=(0.0, 0.0, 1.0))
+        given = dict(self.nominal or {})
+        return {self.axis: given.get(self.axis, ideal)}
+
+    def true_lines(self) -> dict[str, AxisLine]:
+        return {**self.nominal_lines(), **(self.true or {})}
 
 
 class SwivelHead(_Model):
@@ -72,6 +119,24 @@ class SwivelHead(_Model):
 
     type: Literal["swivel_head"] = "swivel_head"
     axes: tuple[Literal["A", "B", "C"], Literal["A", "B", "C"]] = ("A", "B")
+    # kinematic data (design.md §10.6): the axis lines at the zero position, relative to the tool
+    # reference point; ``nominal`` the control's (default: through the reference point along X/Y/Z
+    # of the axis name, the model above), ``true`` the simulator's real ones (default: the nominal)
+    nominal: AxisLines | None = None
+    true: AxisLines | None = None
+
+    @model_validator(mode="after")
+    def _lines(self) -> SwivelHead:
+        for field, lines in (("kinematics.nominal", self.nominal), ("kinematics.true", self.true)):
+            _check_lines(lines or {}, tuple(self.axes), field)
+        return self
+
+    def nominal_lines(self) -> dict[str, AxisLine]:
+        given = dict(self.nominal or {})
+        return {a: given.get(a, AxisLine(direction=AXIS_UNITS[a])) for a in self.axes}
+
+    def true_lines(self) -> dict[str, AxisLine]:
+        return {**self.nominal_lines(), **(self.true or {})}
 
     @field_validator("axes")
     @classmethod

@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import brentq
 
+from .axis_lines import as_line, table_transform
 from .physics import SPINDLE_MOUNTS, rpy_matrix
 from .polygon import convex_pieces
 
@@ -353,8 +354,9 @@ class Scene:
 def workpiece_pose(scenario, table_angle: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """Part -> MCS (R, t) with the rotary table at ``table_angle`` (deg; pose = the part at 0).
 
-    DIN 66217 table: +angle turns the part by −angle about the vertical table axis through
-    ``machine.rotary_table.center``: R' = Rz(−c)·R, t' = Rz(−c)·(t − centre) + centre.
+    DIN 66217 table: +angle turns the part by −angle about the table's TRUE axis line (design.md
+    §10.6, axis_lines.table_transform); nominally the vertical through ``machine.rotary_table.center``:
+    R' = Rz(−c)·R, t' = Rz(−c)·(t − centre) + centre.
     """
     wp = scenario.workpiece
     rot = rpy_matrix(wp.pose.rot)
@@ -362,9 +364,8 @@ def workpiece_pose(scenario, table_angle: float = 0.0) -> tuple[np.ndarray, np.n
     table = scenario.machine.rotary_table
     if table is None or table_angle == 0.0:
         return rot, trans
-    turn = rpy_matrix((0.0, 0.0, -float(table_angle)))
-    centre = np.array([table.center[0], table.center[1], 0.0])
-    return turn @ rot, turn @ (trans - centre) + centre
+    turn, shift = table_transform(as_line(table.true_lines()[table.axis]), table_angle)
+    return turn @ rot, turn @ trans + shift
 
 
 def _cut_from_top(depth: float, block_height: float) -> tuple[float, float]:

@@ -53,7 +53,7 @@ from app.records import PROBE_TOOL_TYPE
 from db import Database
 from engine.alarms import all_alarms
 from engine.alarms import by_number as alarm_by_number
-from engine.coords import GEOMETRY_AXES, LatheToolTip, ToolTip, length_axis
+from engine.coords import GEOMETRY_AXES, LatheToolTip, ToolTip, head_shift_of, length_axis
 from engine.frames import G500, Frame, FrameChain, chain_of, is_basic
 from engine.planes import plane as plane_by_name
 
@@ -127,6 +127,7 @@ class MachineService:
             active = unit.get_state(STATE_ACTIVE_OFFSET, G500)
             tool = unit.get_state(STATE_TOOL, None)
         self._seed_data(reset=False)
+        self._take_nc_tools()
         self._push_nc_data()
         self.activate(active if self._is_settable(active) else G500)
         self._restore_tool(tool)
@@ -178,21 +179,22 @@ class MachineService:
         of changed (the machine's status, mode, lock, offset, chain, plane, feed hold), so that
         polls and the live feed cost no frame arithmetic and no encoding at rest (issue 30)."""
         st = self._machine.status()
-        plane = self._settings.get().plane
+        settings = self._settings.get()
+        plane, units = settings.plane, settings.units
         mode = (self.mode_source() if self.mode_source else None) or st.mode
         lock = self.lock_source() if self.lock_source else None
         machine, chain = self._machine, self._chain
-        key = (st, mode, lock, self._active_offset, plane, self._held_override is not None, self.has_swivel(),
+        key = (st, mode, lock, self._active_offset, plane, units, self._held_override is not None, self.has_swivel(),
                self.diameter_programming, self._scenario)
         last = self._snapshot
         if last is not None and last.machine is machine and last.chain is chain and last.key == key:
             return last
-        snapshot = StatusSnapshot(key, machine, chain, self._status_body(st, plane, mode, lock),
+        snapshot = StatusSnapshot(key, machine, chain, self._status_body(st, plane, units, mode, lock),
                                   (last.version + 1) if last is not None else 1)
         self._snapshot = snapshot
         return snapshot
 
-    def _status_body(self, st: MachineStatus, plane: str, mode: str, lock: dict | None) -> dict:
+    def _status_body(self, st: MachineStatus, plane: str, units: str, mode: str, lock: dict | None) -> dict:
         alarms = [alarm_dict(a) for a in st.alarms]
         program_state = "active" if st.busy else ("interrupted" if alarms else "reset")
         return {
@@ -202,6 +204,7 @@ class MachineService:
             "wcs": self.wcs_from_mcs(st.mcs, st.tool_length, st),
             "active_offset": self._active_offset,
             "plane": plane,
+            "units": units,                 # the screens' units (design.md §9.9): the live feed carries a change
             "tool": st.tool,
             "tool_length": float(st.tool_length),
             "feed_override": float(st.feed_override),
@@ -212,8 +215,13 @@ class MachineService:
             "lock": lock,
             "program_state": program_state,
             "tool_axis": [float(v) for v in getattr(st, "tool_axis", (0.0, 0.0, 1.0))],
+            "head_shift": [float(v) for v in head_shift_of(getattr(st, "head_shift", None))],
             "swivel": self.has_swivel(),
             "controller": self._machine.controller,
+            # design.md §10.7: the controller's E-stop and drives, and the machine's own INI (LinuxCNC)
+            "estop": bool(getattr(st, "estop", False)),
+            "machine_on": bool(getattr(st, "machine_on", True)),
+            "linuxcnc_ini": self._linuxcnc_ini(),
             **self._probe_status(st),
             **(self._lathe_status(st) if self.is_lathe else {}),
         }
@@ -221,6 +229,10 @@ class MachineService:
     def probe_status(self) -> dict:
         """``{"probe", "tool_probe"}`` of ``status()``, read alone (the probe test samples it)."""
         return self._probe_status(self._machine.status())
+
+    def _linuxcnc_ini(self) -> str | None:
+        own = getattr(self._machine, "own_ini", None)
+        return str(own) if own is not None else None
 
     def _probe_status(self, st: MachineStatus) -> dict:
         """``probe`` and ``tool_probe`` (design.md §10.4); a controller that cannot tell its
@@ -287,7 +299,7 @@ class MachineService:
         if tool_length is None:
             tool_length = st.tool_length
         axis = length_axis(getattr(st, "tool_axis", None), self.plane().infeed_unit)
-        return ToolTip(self._chain.wcs2bcs, float(tool_length), axis)
+        return ToolTip(self._chain.wcs2bcs, float(tool_length), axis, head_shift_of(getattr(st, "head_shift", None)))
 
     def wcs_from_mcs(self, mcs: Mapping[str, float], tool_length: float | None = None,
                      st: MachineStatus | None = None) -> dict[str, float]:
@@ -693,11 +705,37 @@ class MachineService:
         old.close()
 
     def _restore_tool(self, tool) -> None:
-        """Put the stored tool back into the spindle; the probe when none is stored or it is gone."""
+        """Put the stored tool back into the spindle; the probe when none is stored or it is gone.
+        A controller that refuses (a tool its own table lacks) keeps its spindle; its alarm shows."""
         try:
-            self.change_tool(tool if tool is not None else self._scenario.probe.t)
-        except NotFoundError:
-            self.change_tool(self._scenario.probe.t)
+            try:
+                self.change_tool(tool if tool is not None else self._scenario.probe.t)
+            except NotFoundError:
+                self.change_tool(self._scenario.probe.t)
+        except AlarmError:
+            pass                                   # posted by the machine (status().alarms)
+
+    def _take_nc_tools(self) -> None:
+        """A controller that owns its tool table (LinuxCNC with the machine's own INI,
+        ``nc_tool_table()``) gives its lengths and radii to the stored tools at the start; a tool
+        whose geometry + wear it holds already keeps the HMI's split."""
+        table = getattr(self._machine, "nc_tool_table", None)
+        held = table() if callable(table) else {}
+        if not held:
+            return
+        with self._db.unit() as unit:
+            for t, nc in held.items():
+                stored = unit.get_tool(t)
+                wear = (stored or {}).get("wear") or {}
+                if stored is not None \
+                        and abs(float(stored["length"]) + float(wear.get("length", 0.0)) - nc["length"]) < 1e-9 \
+                        and abs(float(stored["radius"]) + float(wear.get("radius", 0.0)) - nc["radius"]) < 1e-9:
+                    continue
+                kind = stored["type"] if stored is not None else (PROBE_TOOL_TYPE if t == self._scenario.probe.t
+                                                                  else 120)
+                unit.put_tool(t, {"type": kind, "length": nc["length"], "radius": nc["radius"],
+                                  "wear": {"length": 0.0, "radius": 0.0}}, source="controller",
+                              detail={"reason": "the controller's tool table"})
 
     def _seed_data(self, reset: bool) -> None:
         """Tool table from the scenario's nominal values (probe included) when empty or on reset;

@@ -18,10 +18,12 @@ FIXTURES = frozenset({"ring_bore", "ring_outer", "tool_probe"})
 
 
 def nc_tip(status: dict) -> list[float]:
-    """The tool reference as the NC computes it: axes − L·tool axis (what the position display shows)."""
+    """The tool reference as the NC computes it: axes + head shift − L·tool axis (what the position
+    display shows; the head shift of the NC's kinematic data, design.md §10.6)."""
     mcs, length = status["mcs"], float(status.get("tool_length") or 0.0)
     axis = status.get("tool_axis") or (0.0, 0.0, 1.0)
-    return [float(mcs[a]) - length * float(axis[i]) for i, a in enumerate("XYZ")]
+    shift = status.get("head_shift") or (0.0, 0.0, 0.0)
+    return [float(mcs[a]) + float(shift[i]) - length * float(axis[i]) for i, a in enumerate("XYZ")]
 
 
 def visible_scene(services, hide_part: bool | None = None) -> dict:

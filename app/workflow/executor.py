@@ -8,14 +8,14 @@ conversion between the two is ``engine.coords.ToolTip``, on a lathe ``engine.coo
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from app.machine.protocol import Alarm, Machine, MachineAlarm
-from engine.coords import GEOMETRY_AXES, LatheToolTip, ToolTip, length_axis
+from engine.coords import GEOMETRY_AXES, LatheToolTip, ToolTip, head_shift_of, length_axis
 from engine.frames import Frame
-from engine.types import Latch, MoveStep, ProbeStep, SpindleStep, Step
+from engine.types import Latch, MoveStep, ProbeStep, RotaryStep, SpindleStep, Step
 
 
 class MotionAborted(Exception):
@@ -29,11 +29,18 @@ class StepExecutor:
     tool_length: float          # the NC's offset length L1 of the active tool
     infeed_unit: np.ndarray     # the plane's infeed axis (G17: +Z): where L acts on a 3-axis machine
     tip: ToolTip | LatheToolTip | None = None    # None: the milling convention from the above
+    _own_tip: bool = field(default=False, init=False)   # built here: rebuilt after a rotary axis moved
 
     def __post_init__(self) -> None:
+        self._own_tip = self.tip is None
         if self.tip is None:
-            axis = length_axis(getattr(self.machine.status(), "tool_axis", None), self.infeed_unit)
-            self.tip = ToolTip(self.wcs2bcs, float(self.tool_length), axis)
+            self.tip = self._milling_tip()
+
+    def _milling_tip(self) -> ToolTip:
+        """tip = A + shift − L·axis with the control's tool axis and head shift as they are now."""
+        status = self.machine.status()
+        axis = length_axis(getattr(status, "tool_axis", None), self.infeed_unit)
+        return ToolTip(self.wcs2bcs, float(self.tool_length), axis, head_shift_of(getattr(status, "head_shift", None)))
 
     @property
     def tip_conversion(self) -> ToolTip | LatheToolTip:
@@ -75,6 +82,19 @@ class StepExecutor:
             latched = np.array([probed.latched_mcs[a] for a in GEOMETRY_AXES])
             rec = self.tip_conversion.tip_in(latched, step.coords)
             return Latch(triggered=True, rec=rec, latched_mcs=latched)
+        if isinstance(step, RotaryStep):
+            target = dict(step.axes)
+            if step.tip is not None:          # to the zero position: tip = A − L·spindle axis
+                if any(abs(v) > 1e-12 for v in target.values()):
+                    raise ValueError(f"RotaryStep.tip: only with every rotary axis at 0, got {target}")
+                axes = np.asarray(step.tip, dtype=float) + float(self.tool_length) * np.asarray(self.infeed_unit)
+                target.update({a: float(v) for a, v in zip(GEOMETRY_AXES, axes, strict=True)})
+            result = self.machine.goto(target, None)
+            if not result.completed:
+                self._raise_for(result.alarm)
+            if self._own_tip:                 # a head axis turned the NC's tool axis (design.md §10.6)
+                self.tip = self._milling_tip()
+            return None
         if isinstance(step, SpindleStep):
             if step.angle is not None:
                 self.machine.spindle_position(step.angle)

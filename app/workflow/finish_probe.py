@@ -17,7 +17,7 @@ from app.records import ProbeData
 from app.workflow.context import MeasuringContext
 from app.workflow.session import MeasureSession
 from engine import alarms
-from engine.calibration import evaluate_probe_task
+from engine.calibration import calibrate_surface, evaluate_probe_task, probe_values
 from engine.types import MeasuringError, ProbeRecord
 
 # the ring passes could not tell whether the pre-travel turns with the spindle (engine.calibration)
@@ -136,6 +136,21 @@ def finish_probe_length(session: MeasureSession, ctx: MeasuringContext, points: 
     tool_row = {k: v for k, v in tool.items() if k in ("t", "name", "type", "length", "radius", "wear")}
     tool_row["length"] = length_new
     return answer, {"offset": None, "probe_update": (n, record), "tool_update": (t, tool_row)}
+
+
+def finish_probe_surface(session: MeasureSession, ctx: MeasuringContext, points: list) -> tuple[dict, dict]:
+    """CYCLE976 ``_MVAR=0`` (manual §5.3.3): the trigger value of one direction on a surface at
+    ``params.setpoint`` (engine.calibration.calibrate_surface); L1 and the other directions stay."""
+    probe = _probe_of(ctx)
+    axis, setpoint = session.params["axis"], float(session.params["setpoint"])
+    try:
+        new, values = calibrate_surface(points[0], axis, setpoint, probe, safe_area=session.params.get("safe_area"))
+    except ValueError as exc:
+        raise MeasuringError(alarms.PROBE_NOT_SWITCHED, str(exc)) from exc
+    n, record = _record(ctx, new, {"cal_height": setpoint, "cal_wo": ctx.active_offset})
+    values["probe"] = {**probe_values(new), **_calibration_view(record)}
+    answer = {"result": values, "correction": None, "activated": False, "setup_support": None}
+    return answer, {"offset": None, "probe_update": (n, record)}
 
 
 def _calibration_view(record: dict) -> dict:

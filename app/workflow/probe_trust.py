@@ -80,7 +80,7 @@ def uncalibrated(record: Mapping[str, Any] | None, task: str, infeed: bool, keys
 
     if infeed and task != "probe.length" and not data.get("calibrated_length"):
         missing(f"length {plane.infeed}-: calibrate the probe length on a known surface first")
-    if task != "probe.radius" and keys:
+    if task not in ("probe.radius", "probe.surface") and keys:      # both calibrate these directions
         trigger = data.get("trigger") or {}
         absent = [k for k in keys if k != "plane" and k not in trigger]
         if not data.get("calibrated_radius"):

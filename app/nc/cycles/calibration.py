@@ -5,7 +5,8 @@ toolprobe.calibrate / tool.length / tool.diameter.
 CYCLE976: 4-direction bore variants (units digit 1 known or 8 unknown centre, 4th digit 0) run
 the JOG ring calibration (centre search, passes at SPOS 180° and 0°: skew, trigger values and the
 effective ball diameter are always determined); 10000 calibrates the length on a surface at
-``_SETVAL``. CYCLE971: 0 calibrates the tool probe (``_MA`` 3: length only, else all
+``_SETVAL``; 0 calibrates the trigger value of one direction (``_MA``, ``_MD``) on a surface at
+``_SETVAL`` (manual §5.3.3, ``%_N_KALIBRIEREN_IN_Z_MPF``). CYCLE971: 0 calibrates the tool probe (``_MA`` 3: length only, else all
 directions), 1 and 2 measure the length (``_MA`` 3) or the radius (``_MA`` 1/2) of the tool in
 the spindle (stationary or rotating as the JOG task decides it from the tool and probe sizes),
 ``_CHBIT[3]`` 0 into the geometry, 1 into the wear; 100000 is the automatic calibration.
@@ -13,9 +14,15 @@ the spindle (stationary or rotating as the JOG task decides it from the tool and
 
 from __future__ import annotations
 
+import dataclasses
+
 from app.nc.cycles.base import Call, CycleAlarm, digit, run_cycle, variant_error
-from app.workflow.tasks import TASKS
+from app.workflow import finish_probe
+from app.workflow.tasks import TASKS, TaskSpec
 from engine import alarms
+from engine.plan_workpiece import surface_program
+from engine.planes import Plane
+from engine.tasks import EngineTask, Family
 
 TRIGGER_SLOTS = {"-1": 8, "+1": 10, "-2": 12, "+2": 14, "-3": 16, "+3": 18}
 
@@ -32,6 +39,34 @@ def _trigger_results(call: Call, new: dict, old: dict) -> None:
                 call.ovr[slot + 1] = call.out(new[key] - float(old.get(key, new[key])))
 
 
+def _surface_params(params: dict, plane: Plane) -> dict:
+    """The cycle builds these itself (never operator input): axis, direction, surface, _TSA."""
+    return {k: params[k] for k in ("axis", "direction", "setpoint", "safe_area") if k in params}
+
+
+def _surface_program(params, n, start, ctx, label):
+    d = (1.0 if params["direction"] == "+" else -1.0) * ctx.plane.unit(params["axis"])
+    return surface_program(d, float(params["setpoint"]), start, ctx, label,
+                           stay=params["axis"] == ctx.plane.infeed)
+
+
+# CYCLE976 _MVAR=0 (manual §5.3.3): a task of the cycle only; the JOG screens calibrate length and ring
+SURFACE_CALIBRATION = dataclasses.replace(
+    TASKS["probe.length"], engine=EngineTask("probe.surface", Family.PROBE, 1, _surface_params, _surface_program),
+    finish=finish_probe.finish_probe_surface, validator=None, planner=None)
+
+
+def _surface_variant(call: Call, setval: float) -> tuple[TaskSpec, dict]:
+    ma, md = call.integer("_MA"), call.integer("_MD")
+    if ma not in (1, 2, 3):
+        raise CycleAlarm(alarms.MEASURING_AXIS, f"_MVAR=0: _MA = {ma}: the measuring axis is 1, 2 or 3")
+    if md not in (0, 1):
+        raise CycleAlarm(alarms.NC_VALUE_RANGE, f"_MVAR=0: _MD = {md}: 0 positive, 1 negative direction")
+    axis = call.plane.axes[ma - 1]
+    return SURFACE_CALIBRATION, {"axis": axis, "direction": "+" if md == 0 else "-", "setpoint": setval,
+                                 "safe_area": call.length("_TSA")}
+
+
 def cycle976(call: Call) -> None:
     v = call.variant
     env = call.measuring()
@@ -41,7 +76,11 @@ def cycle976(call: Call) -> None:
     old = before.probe
     setval = call.length("_SETVAL")
     params: dict[str, object]                           # the task's JSON params
-    if v == 10000:
+    spec = None
+    if v == 0:
+        spec, params = _surface_variant(call, setval)
+        task = spec.name
+    elif v == 10000:
         if call.integer("_MA") not in (0, 3):
             raise CycleAlarm(alarms.MEASURING_AXIS, "_MVAR=10000 calibrates the length in the applicate: _MA=3")
         task, params = "probe.length", {"setpoint": {call.plane.infeed: setval}}
@@ -49,14 +88,12 @@ def cycle976(call: Call) -> None:
         if not setval > 0.0:
             raise CycleAlarm(alarms.NC_VALUE_RANGE, f"_SETVAL = {setval:g}: the ring diameter must be > 0")
         task, params = "probe.radius", {"diameter": setval}
-    elif v == 0:
-        raise variant_error(call, "the surface calibration of one direction (_MVAR=0) is not supported; "
-                                  "10000 calibrates the length")
     else:
-        raise variant_error(call, "supported: 10000 (length on a surface) and the 4-direction bore variants "
+        raise variant_error(call, "supported: 0 (one direction on a surface), 10000 (length on a surface) and "
+                                  "the 4-direction bore variants "
                                   "(xx0x01, xx0x08; 1 or 2 directions and 'at an angle' are not supported)")
     params["measurements"] = call.measurements()
-    answer = call.run(env, TASKS[task], params, "measure_only")
+    answer = call.run(env, spec or TASKS[task], params, "measure_only")
     result = answer.get("result") or {}
     probe = result.get("probe") or {}
     new_trigger = {k: float(x) for k, x in (probe.get("trigger") or {}).items()}
