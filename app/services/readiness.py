@@ -91,7 +91,7 @@ class ReadinessService:
         out.append(Check("no_alarm", "Machine", "No alarm pending", newest is None,
                          "no alarm" if newest is None else f"{newest.text}: press Reset",
                          newest.code if newest else None))
-        has_tp = s.machine.scenario.tool_probe is not None
+        has_tp = s.machine.has_tool_probe
         out.append(Check("tool_probe_present", "Machine", "Switching tool probe installed", has_tp,
                          "tool probe on the table" if has_tp else "this machine has no tool probe",
                          None, "error", (TOOLPROBE_CAL, TOOL)))
