@@ -11,7 +11,7 @@ tool reference point (spindle nose). Probing directions are unit vectors in MCS.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Protocol, runtime_checkable
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -97,6 +97,8 @@ class MachineStatus:
     #                                                           horizontal spindle: scenario machine.spindle_axis)
     probe: ProbeState | None = None          # the workpiece probe; None: the controller cannot tell
     tool_probe: ProbeState | None = None     # the tool probe; None: none, or the controller cannot tell
+    estop: bool = False                      # the controller's emergency stop is active (design.md §10.7)
+    machine_on: bool = True                  # the drives are on (LinuxCNC: task state ON)
     # where the control's head kinematics put the spindle nose relative to the X/Y/Z axis position
     # (MCS, mm; design.md §10.6): 0 for a head turning about the tool reference point, or no head
     head_shift: tuple[float, float, float] = (0.0, 0.0, 0.0)
@@ -228,7 +230,7 @@ class KinematicData(Protocol):
     ``{axis: {"point": [x, y, z], "direction": [dx, dy, dz]}}`` at the zero position of every
     rotary axis (head axes relative to the tool reference point, a table's in MCS)."""
 
-    def kinematic_data(self) -> dict[str, dict[str, list[float]]]: ...
+    def kinematic_data(self) -> dict[str, dict[str, Any]]: ...
 
     def write_kinematic_data(self, lines: dict) -> None:
         """Replace the lines of the axes given (others keep theirs); ValueError names a bad axis."""

@@ -7,6 +7,8 @@ feed alone (no reload). The NC Start of a measuring screen with a deflected prob
 from __future__ import annotations
 
 import pytest
+from live import wait_for_requests
+from playwright.sync_api import Error as PlaywrightError
 from playwright.sync_api import expect
 
 pytestmark = pytest.mark.e2e
@@ -58,6 +60,40 @@ def test_tool_probe_test_softkey(page, api):
     expect(test).to_have_attribute("data-state", "waiting")
     api.post("/api/sim/probe", json={"probe": "tool", "deflect": True})
     expect(test).to_have_attribute("data-state", "switched")
+
+
+def test_probe_test_softkey_while_the_pane_refreshes(page, api):
+    """The softkey pressed while the pane's own refresh (the live feed's first event) is on its
+    way, and the refresh answered first (a busy computer; CI): the refresh replaced the pane and
+    the softkey's answer landed in the removed pane, so the screen kept the last test. The
+    softkey's answer must show."""
+    held: dict = {}
+
+    def hold(route):         # the server answers at once; the browser gets the answer when released
+        name = "refresh" if route.request.method == "GET" else "start"
+        held.setdefault(name, (route, route.fetch()))
+
+    page.route("**/jog/probe-test", hold)
+    try:
+        page.goto("/jog")
+        wait_for_requests(page, held)                           # the pane's refresh is on its way
+        page.locator("#vsoftkeys .softkey", has_text="Tool probe test").click()
+        wait_for_requests(page, held, 2)
+        route, answer = held["refresh"]
+        try:
+            route.fulfill(response=answer)                      # the refresh answers first
+        except PlaywrightError:
+            pass                                                # the softkey cancelled it
+        expect(page.locator("#probe-pane.htmx-request")).to_have_count(0)
+        route, answer = held["start"]
+        with page.expect_response("**/jog/probe-test"):
+            route.fulfill(response=answer)
+    finally:
+        page.unroute("**/jog/probe-test")
+    test = page.locator("#probe-test")
+    expect(test).to_have_attribute("data-probe", "tool")
+    expect(test).to_have_attribute("data-state", "waiting")
+    assert api.get("/api/probe/test").json()["probe"] == "tool"
 
 
 def test_probe_test_on_a_deflected_probe_says_why_in_german(page, api):
