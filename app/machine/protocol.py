@@ -268,6 +268,19 @@ class FrameCapacity(Protocol):
 
 
 @runtime_checkable
+class OwnConfiguration(Protocol):
+    """Optional: a control started on the machine's own configuration (LinuxCNC ``--linuxcnc-ini``):
+    its INI file and the tool table it holds, which the HMI takes over at its start."""
+
+    @property
+    def own_ini(self):
+        """The machine's own INI file (a path), None on a generated configuration."""
+
+    def nc_tool_table(self) -> dict[int, dict]:
+        """{T: {"length", "radius"}} as the control holds them; {} on a generated configuration."""
+
+
+@runtime_checkable
 class SimulatorControl(Protocol):
     """Only the simulator offers these: its truth (never used for measuring), scenario load and
     the time scale. The HMI asks ``isinstance(machine, SimulatorControl)`` before using them."""

@@ -45,6 +45,7 @@ from app.machine.protocol import (
     MachineBusy,
     MachineStatus,
     MoveResult,
+    OwnConfiguration,
     ProbeState,
     SimulatorControl,
     SwivelHead,
@@ -215,7 +216,8 @@ class MachineService:
         return self._probe_status(self._machine.status())
 
     def _linuxcnc_ini(self) -> str | None:
-        own = getattr(self._machine, "own_ini", None)
+        machine = self._machine
+        own = machine.own_ini if isinstance(machine, OwnConfiguration) else None
         return str(own) if own is not None else None
 
     def _probe_status(self, st: MachineStatus) -> dict:
@@ -706,8 +708,8 @@ class MachineService:
         """A controller that owns its tool table (LinuxCNC with the machine's own INI,
         ``nc_tool_table()``) gives its lengths and radii to the stored tools at the start; a tool
         whose geometry + wear it holds already keeps the HMI's split."""
-        table = getattr(self._machine, "nc_tool_table", None)
-        held = table() if callable(table) else {}
+        machine = self._machine
+        held = machine.nc_tool_table() if isinstance(machine, OwnConfiguration) else {}
         if not held:
             return
         with self._db.unit() as unit:
