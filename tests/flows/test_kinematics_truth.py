@@ -157,3 +157,25 @@ def test_fork_head_c_axis_measured_with_b_tilted(tmp_path):
             assert (result["partner"] == {"B": 30.0}) == (axis == "C")
         status = client.get("/api/machine").json()
         assert status["mcs"]["B"] == 0.0 and status["mcs"]["C"] == 0.0      # back at the zero position
+
+
+def test_cycle996_in_a_program_optimises_the_a_axis(tmp_path):
+    """The CYCLE996-like cycle in MDA: _MVAR=1 optimises; _OVR carries the measured line, the
+    control's data hold it afterwards (truth: the scenario's A line)."""
+    sc = kin_scenario(sigma=0.0, true=TRUE_HEAD)
+    c = sphere_mcs(sc)
+    text = (f"_MVAR=1 _MA=1 _SETVAL={SPHERE_D} _SETV[0]={c[0]:.4f} _SETV[1]={c[1]:.4f} _SETV[2]={c[2]:.4f} "
+            "_SETV[3]=3 _STA1=-45 _INCA=45 _FA=5\nCYCLE996\nM30")
+    with make_client(tmp_path, sc) as client:
+        run = post(client, "/api/nc/run", {"mda": text})
+        assert run["state"] == "done", run
+        names = ",".join(f"_OVR[{i}]" for i in range(13)) + ",_OVI[11]"
+        values = client.get("/api/nc/variables", params={"names": names}).json()
+        flat = values.get("variables", values)
+        ovr = [float(flat[f"_OVR[{i}]"]) for i in range(13)]
+        distance, angle = line_errors({"point": ovr[0:3], "direction": ovr[3:6]}, TRUE_HEAD["A"])
+        assert distance < 1e-6 and angle < 1e-6                     # noise-free: exact
+        assert int(flat["_OVI[11]"]) == 1
+        assert abs(ovr[12] - SPHERE_D) < 1e-6
+        stored = client.get("/api/kinematics").json()["A"]
+        assert np.allclose(stored["point"], ovr[0:3], atol=1e-9)
