@@ -23,6 +23,7 @@ With a swivel head turned out of +Z the length goes along the machine's actual t
 
 from __future__ import annotations
 
+import json
 import threading
 import time
 from collections.abc import Callable, Mapping
@@ -81,6 +82,22 @@ def alarm_dict(alarm: Alarm) -> dict:
     return {"code": alarm.code, "text": alarm.text, "remedy": definition.remedy if definition else ""}
 
 
+class StatusSnapshot:
+    """One state version of ``MachineService.status()``: the body and its JSON bytes (encoded once,
+    on first use, as FastAPI's JSONResponse encodes). ``key``/``machine``/``chain``: what it was made of."""
+
+    def __init__(self, key: tuple, machine: Machine, chain: FrameChain, body: dict, version: int):
+        self.key, self.machine, self.chain, self.body, self.version = key, machine, chain, body, version
+        self._json: bytes | None = None
+
+    @property
+    def json(self) -> bytes:
+        if self._json is None:
+            self._json = json.dumps(self.body, ensure_ascii=False, allow_nan=False, indent=None,
+                                    separators=(",", ":")).encode("utf-8")
+        return self._json
+
+
 class MachineService:
     """Thin, thread-safe orchestration around a ``Machine``; every method returns plain data."""
 
@@ -104,6 +121,7 @@ class MachineService:
         self.mode_source: Callable[[], str | None] | None = None   # the NC channel's mode (MDA/AUTO)
         # what runs and locks the rest ({"mode", "program"}: a program, a JOG measurement) or None
         self.lock_source: Callable[[], dict | None] | None = None
+        self._snapshot: StatusSnapshot | None = None
         self.changes = ChangeSignal()        # a change without motion (a probe deflected by hand): the live feed
         with db.unit(readonly=True) as unit:
             active = unit.get_state(STATE_ACTIVE_OFFSET, G500)
@@ -152,19 +170,41 @@ class MachineService:
         return plane_by_name("G18" if self.is_lathe else self._settings.get().plane)
 
     def status(self) -> dict:
-        """The ``GET /api/machine`` body (design.md §4) plus channel, tool length, program state."""
+        """The ``GET /api/machine`` body (design.md §4) plus channel, tool length, program state.
+        Shared by every caller until the state changes (``snapshot``): read it, never change it."""
+        return self.snapshot().body
+
+    def snapshot(self) -> StatusSnapshot:
+        """The state as one value per state version: built again only when something it is made
+        of changed (the machine's status, mode, lock, offset, chain, plane, feed hold), so that
+        polls and the live feed cost no frame arithmetic and no encoding at rest (issue 30)."""
         st = self._machine.status()
         settings = self._settings.get()
+        plane, units = settings.plane, settings.units
+        mode = (self.mode_source() if self.mode_source else None) or st.mode
+        lock = self.lock_source() if self.lock_source else None
+        machine, chain = self._machine, self._chain
+        key = (st, mode, lock, self._active_offset, plane, units, self._held_override is not None, self.has_swivel(),
+               self.diameter_programming, self._scenario)
+        last = self._snapshot
+        if last is not None and last.machine is machine and last.chain is chain and last.key == key:
+            return last
+        snapshot = StatusSnapshot(key, machine, chain, self._status_body(st, plane, units, mode, lock),
+                                  (last.version + 1) if last is not None else 1)
+        self._snapshot = snapshot
+        return snapshot
+
+    def _status_body(self, st: MachineStatus, plane: str, units: str, mode: str, lock: dict | None) -> dict:
         alarms = [alarm_dict(a) for a in st.alarms]
         program_state = "active" if st.busy else ("interrupted" if alarms else "reset")
         return {
-            "mode": (self.mode_source() if self.mode_source else None) or st.mode,
+            "mode": mode,
             "channel": CHANNEL,
             "mcs": {a: float(v) for a, v in st.mcs.items()},
-            "wcs": self.wcs_from_mcs(st.mcs, st.tool_length),
+            "wcs": self.wcs_from_mcs(st.mcs, st.tool_length, st),
             "active_offset": self._active_offset,
-            "plane": settings.plane,
-            "units": settings.units,        # the screens' units (design.md §9.9): the live feed carries a change
+            "plane": plane,
+            "units": units,                 # the screens' units (design.md §9.9): the live feed carries a change
             "tool": st.tool,
             "tool_length": float(st.tool_length),
             "feed_override": float(st.feed_override),
@@ -172,7 +212,7 @@ class MachineService:
             "alarms": alarms,
             "busy": bool(st.busy),
             "feed_hold": self._held_override is not None,
-            "lock": self.lock_source() if self.lock_source else None,
+            "lock": lock,
             "program_state": program_state,
             "tool_axis": [float(v) for v in getattr(st, "tool_axis", (0.0, 0.0, 1.0))],
             "head_shift": [float(v) for v in head_shift_of(getattr(st, "head_shift", None))],
@@ -249,9 +289,10 @@ class MachineService:
         return self._run(lambda: head.swivel_to_wcs(rotation, infeed))
 
     # --- coordinates ----------------------------------------------------------------------
-    def _tip(self, tool_length: float | None) -> ToolTip | LatheToolTip:
+    def _tip(self, tool_length: float | None, st: MachineStatus | None = None) -> ToolTip | LatheToolTip:
         """Tool tip <-> axis positions in the active chain (``engine.coords``)."""
-        st = self._machine.status()
+        if st is None:
+            st = self._machine.status()
         if self.is_lathe:
             l1, l2 = getattr(st, "tool_lengths", (0.0, 0.0))
             return LatheToolTip(self._chain.wcs2bcs, float(l1), float(l2))
@@ -260,8 +301,9 @@ class MachineService:
         axis = length_axis(getattr(st, "tool_axis", None), self.plane().infeed_unit)
         return ToolTip(self._chain.wcs2bcs, float(tool_length), axis, head_shift_of(getattr(st, "head_shift", None)))
 
-    def wcs_from_mcs(self, mcs: Mapping[str, float], tool_length: float | None = None) -> dict[str, float]:
-        p_wcs = self._tip(tool_length).tip_in_wcs([float(mcs.get(a, 0.0)) for a in GEOMETRY_AXES])
+    def wcs_from_mcs(self, mcs: Mapping[str, float], tool_length: float | None = None,
+                     st: MachineStatus | None = None) -> dict[str, float]:
+        p_wcs = self._tip(tool_length, st).tip_in_wcs([float(mcs.get(a, 0.0)) for a in GEOMETRY_AXES])
         out = {a: float(v) for a, v in zip(GEOMETRY_AXES, p_wcs, strict=True)}
         if self.diameter_programming:
             out["X"] *= 2.0                      # DIAMON: WCS X as a diameter (turning.md §0.3)
