@@ -296,7 +296,7 @@ class MeasuringEnv:
             unit.add_audit("guard", task, {"guard": True}, {"guard": False}, "measure", {"task": task})
 
     def activate(self, name: str) -> None:
-        self._ms.activate(name)
+        self._ms.make_active(name)
 
     def refresh_frames(self) -> None:
         self._ms.refresh_frame()
