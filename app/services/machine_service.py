@@ -23,6 +23,7 @@ With a swivel head turned out of +Z the length goes along the machine's actual t
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import threading
@@ -40,11 +41,14 @@ from app.machine.lathe_scenario import LatheScenario
 from app.machine.protocol import (
     ActiveFrame,
     Alarm,
+    FrameCapacity,
+    Lathe,
     Machine,
     MachineAlarm,
     MachineBusy,
     MachineStatus,
     MoveResult,
+    OwnConfiguration,
     ProbeState,
     SimulatorControl,
     SwivelHead,
@@ -55,7 +59,7 @@ from db import Database, StorageUnavailable
 from engine.alarms import all_alarms
 from engine.alarms import by_number as alarm_by_number
 from engine.coords import GEOMETRY_AXES, LatheToolTip, ToolTip, head_shift_of, length_axis
-from engine.frames import G500, Frame, FrameChain, chain_of, is_basic
+from engine.frames import G500, SETFRAME, Frame, FrameChain, basic_frame_names, chain_of, is_basic
 from engine.planes import plane as plane_by_name
 
 from . import lathe_data
@@ -129,17 +133,24 @@ class MachineService:
         with db.unit(readonly=True) as unit:
             active = unit.get_state(STATE_ACTIVE_OFFSET, G500)
             tool = unit.get_state(STATE_TOOL, None)
-        self._at_start(partial(self._seed_data, reset=False))
+        self._at_start(self._seed_data, False)
         self._at_start(self._take_nc_tools)
         self._push_nc_data()
-        self._at_start(partial(self.activate, active if self._is_settable(active) else G500))
-        self._at_start(partial(self._restore_tool, tool))
+        self._at_start(self._activate_stored, active)
+        self._at_start(self._restore_tool, tool)
 
-    def _at_start(self, step: Callable[[], object]) -> None:
+    def _activate_stored(self, active: str) -> None:
+        try:
+            self.activate(active if self._is_settable(active) else G500)
+        except AlarmError:                     # a stored frame the NC cannot hold: no offset, alarm shown
+            with contextlib.suppress(AlarmError):
+                self.activate(G500)
+
+    def _at_start(self, step: Callable[..., object], *args: object) -> None:
         """A start-up step; on a database that cannot be written (design.md §10.8) what it would
         store is left out and the HMI starts read only."""
         try:
-            step()
+            step(*args)
         except StorageUnavailable as exc:
             if not self._db.read_only:
                 raise
@@ -170,14 +181,36 @@ class MachineService:
     def chain(self) -> FrameChain:
         return self._chain
 
+    # --- what the machine is (its capabilities, protocol.py; asked here once each) ----------------
     @property
     def is_lathe(self) -> bool:
         """The machine is a lathe (turning.md §10.2): X radius, DIAMON, the lathe tasks."""
-        return getattr(self._machine, "kind", "mill") == "lathe"
+        return isinstance(self._machine, Lathe)
 
     @property
     def diameter_programming(self) -> bool:
-        return self.is_lathe and bool(getattr(self._machine, "diameter_programming", False))
+        machine = self._machine
+        return isinstance(machine, Lathe) and bool(machine.diameter_programming)
+
+    @property
+    def spos_capable(self) -> bool:
+        """SPOS possible: every milling spindle here; a lathe's main spindle as commissioned."""
+        machine = self._machine
+        return not isinstance(machine, Lathe) or bool(machine.spos_capable)
+
+    # --- the machine's commissioning data (the scenario's machine section, design.md §4) ----------
+    def limits(self) -> dict:
+        """The software limits per axis (MCS)."""
+        return self._scenario.limits()
+
+    @property
+    def rapid_feed(self) -> float:
+        """The rapid traverse (mm/min)."""
+        return float(self._scenario.machine.rapid)
+
+    @property
+    def has_tool_probe(self) -> bool:
+        return self._scenario.tool_probe is not None
 
     def plane(self):
         return plane_by_name("G18" if self.is_lathe else self._settings.get().plane)
@@ -244,7 +277,8 @@ class MachineService:
         return self._probe_status(self._machine.status())
 
     def _linuxcnc_ini(self) -> str | None:
-        own = getattr(self._machine, "own_ini", None)
+        machine = self._machine
+        own = machine.own_ini if isinstance(machine, OwnConfiguration) else None
         return str(own) if own is not None else None
 
     def _probe_status(self, st: MachineStatus) -> dict:
@@ -282,6 +316,11 @@ class MachineService:
     def has_swivel(self) -> bool:
         head = self._swivel_head()
         return head is not None and bool(head.has_swivel())
+
+    def head_axes(self) -> tuple[str, ...]:
+        """The swivel head's axes (A/B/C), in their order; () without a swivel head."""
+        head = self._swivel_head()
+        return tuple(head.head_axes()) if head is not None and head.has_swivel() else ()
 
     def retract_tool_axis(self, distance: float | None = None) -> dict:
         """Retract up along the tool axis (to the limits by default) before a swivel (jog-measuring §11 Q9)."""
@@ -654,10 +693,16 @@ class MachineService:
         return chain_of(self.stored_frames(), active)
 
     def activate(self, name: str) -> dict:
+        self.make_active(name)
+        return self.status()
+
+    def make_active(self, name: str) -> None:
+        """``activate`` without building the state to answer (a measurement's commit needs none)."""
         if not isinstance(name, str) or not self._is_settable(name.upper()):
             raise InvalidInput(f"offset: {name!r} is not a settable zero offset (G500, G54..)", field="offset")
         name = name.upper()
         with self._lock:
+            self._check_chain_holds(name)
             chain = self.build_chain(name)
             wcs2bcs = chain.wcs2bcs
             self._machine.activate_frame(ActiveFrame(name=name, wcs2bcs=wcs2bcs.as_matrix(),
@@ -667,11 +712,23 @@ class MachineService:
             if changed:          # re-activating the same WO (after a correction) needs no write
                 with self._db.unit() as unit:
                     unit.set_state(STATE_ACTIVE_OFFSET, name)
-        return self.status()
+
+    def _check_chain_holds(self, name: str) -> None:
+        """Every frame of the chain ``name`` would make active (the basic frames and ``name``) is one
+        the NC holds (design.md §10.7, issue 34 §5): LinuxCNC holds no rotation about X or Y and no
+        basic frame, so such an activation is refused with the NC's alarm (409, 61321), nothing
+        shown as active that the NC does not move by."""
+        if not isinstance(self._machine, FrameCapacity):
+            return
+        with self._db.unit(readonly=True) as unit:
+            stored = unit.list_offsets()
+        names = [n for n in (SETFRAME, *basic_frame_names(stored)) if n in stored]
+        for frame_name in [*names, *([name] if name != G500 and name in stored else [])]:
+            self.check_holds(frame_name, stored[frame_name])
 
     def refresh_frame(self) -> None:
         """Re-compose the active chain after an offset was written (BASIC_*, or the active WO)."""
-        self.activate(self._active_offset)
+        self.make_active(self._active_offset)
 
     # --- scenario -----------------------------------------------------------------------------
     def _simulator(self, what: str) -> SimulatorControl:
@@ -696,7 +753,7 @@ class MachineService:
             self._scenario = scenario
             self._seed_data(reset=reset_data)
             self._push_nc_data()
-            self.activate(G500 if reset_data else self._active_offset)
+            self.make_active(G500 if reset_data else self._active_offset)
             with self._db.unit(readonly=True) as unit:
                 tool = unit.get_state(STATE_TOOL, None)
             self._restore_tool(tool)
@@ -732,8 +789,8 @@ class MachineService:
         """A controller that owns its tool table (LinuxCNC with the machine's own INI,
         ``nc_tool_table()``) gives its lengths and radii to the stored tools at the start; a tool
         whose geometry + wear it holds already keeps the HMI's split."""
-        table = getattr(self._machine, "nc_tool_table", None)
-        held = table() if callable(table) else {}
+        machine = self._machine
+        held = machine.nc_tool_table() if isinstance(machine, OwnConfiguration) else {}
         if not held:
             return
         with self._db.unit() as unit:
@@ -842,10 +899,10 @@ class MachineService:
     def check_holds(self, name: str, frame: Mapping) -> None:
         """Before the db write: a frame this NC cannot hold as ``name`` (LinuxCNC: a tilted G54, a
         basic frame) is refused here, a 409 alarm, so the HMI never stores what the NC lacks."""
-        holds = getattr(self._machine, "holds", None)
-        if not callable(holds):
+        machine = self._machine
+        if not isinstance(machine, FrameCapacity):
             return
-        refused = holds(name, self._nc_frame(frame))
+        refused = machine.holds(name, self._nc_frame(frame))
         if refused is not None:
             self._machine.post_alarm(refused)          # as the NC would show a refused write
             raise AlarmError(refused.code, refused.text)
