@@ -23,6 +23,7 @@ With a swivel head turned out of +Z the length goes along the machine's actual t
 
 from __future__ import annotations
 
+import contextlib
 import json
 import threading
 import time
@@ -57,7 +58,7 @@ from db import Database
 from engine.alarms import all_alarms
 from engine.alarms import by_number as alarm_by_number
 from engine.coords import GEOMETRY_AXES, LatheToolTip, ToolTip, head_shift_of, length_axis
-from engine.frames import G500, Frame, FrameChain, chain_of, is_basic
+from engine.frames import G500, SETFRAME, Frame, FrameChain, basic_frame_names, chain_of, is_basic
 from engine.planes import plane as plane_by_name
 
 from . import lathe_data
@@ -132,7 +133,11 @@ class MachineService:
         self._seed_data(reset=False)
         self._take_nc_tools()
         self._push_nc_data()
-        self.activate(active if self._is_settable(active) else G500)
+        try:
+            self.activate(active if self._is_settable(active) else G500)
+        except AlarmError:                     # a stored frame the NC cannot hold: no offset, alarm shown
+            with contextlib.suppress(AlarmError):
+                self.activate(G500)
         self._restore_tool(tool)
 
     # --- read-only views ----------------------------------------------------------------
@@ -672,10 +677,16 @@ class MachineService:
         return chain_of(self.stored_frames(), active)
 
     def activate(self, name: str) -> dict:
+        self.make_active(name)
+        return self.status()
+
+    def make_active(self, name: str) -> None:
+        """``activate`` without building the state to answer (a measurement's commit needs none)."""
         if not isinstance(name, str) or not self._is_settable(name.upper()):
             raise InvalidInput(f"offset: {name!r} is not a settable zero offset (G500, G54..)", field="offset")
         name = name.upper()
         with self._lock:
+            self._check_chain_holds(name)
             chain = self.build_chain(name)
             wcs2bcs = chain.wcs2bcs
             self._machine.activate_frame(ActiveFrame(name=name, wcs2bcs=wcs2bcs.as_matrix(),
@@ -685,11 +696,23 @@ class MachineService:
             if changed:          # re-activating the same WO (after a correction) needs no write
                 with self._db.unit() as unit:
                     unit.set_state(STATE_ACTIVE_OFFSET, name)
-        return self.status()
+
+    def _check_chain_holds(self, name: str) -> None:
+        """Every frame of the chain ``name`` would make active (the basic frames and ``name``) is one
+        the NC holds (design.md §10.7, issue 34 §5): LinuxCNC holds no rotation about X or Y and no
+        basic frame, so such an activation is refused with the NC's alarm (409, 61321), nothing
+        shown as active that the NC does not move by."""
+        if not isinstance(self._machine, FrameCapacity):
+            return
+        with self._db.unit(readonly=True) as unit:
+            stored = unit.list_offsets()
+        names = [n for n in (SETFRAME, *basic_frame_names(stored)) if n in stored]
+        for frame_name in [*names, *([name] if name != G500 and name in stored else [])]:
+            self.check_holds(frame_name, stored[frame_name])
 
     def refresh_frame(self) -> None:
         """Re-compose the active chain after an offset was written (BASIC_*, or the active WO)."""
-        self.activate(self._active_offset)
+        self.make_active(self._active_offset)
 
     # --- scenario -----------------------------------------------------------------------------
     def _simulator(self, what: str) -> SimulatorControl:
@@ -714,7 +737,7 @@ class MachineService:
             self._scenario = scenario
             self._seed_data(reset=reset_data)
             self._push_nc_data()
-            self.activate(G500 if reset_data else self._active_offset)
+            self.make_active(G500 if reset_data else self._active_offset)
             with self._db.unit(readonly=True) as unit:
                 tool = unit.get_state(STATE_TOOL, None)
             self._restore_tool(tool)
