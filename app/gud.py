@@ -71,6 +71,9 @@ class GudSettings(BaseModel):
     measuring_path: float = _f(50.0, "E_MESS_D_M", "Measuring path before/after the point", WORKPIECE, "mm",
                                gt=0, le=1000)
     spigot_safety: float = _f(5.0, "-", "Safety distance around spigots", WORKPIECE, "mm", ge=0, le=100)
+    # KinematicsOpt-like sphere check of the kinematics measurement (design.md §10.6)
+    kinematics_sphere_tolerance: float = _f(0.02, "-", "Measuring kinematics: permitted deviation of the "
+                                            "calibration sphere's diameter", WORKPIECE, "mm", gt=0, le=1)
     cal_ring_diameter: float = _f(0.0, "E_MESS_CAL_D", "Calibration ring diameter", WORKPIECE, "mm",
                                   ge=0, le=1000)
     cal_chords: bool = _f(True, "-", "Ring calibration also along off-centre chords (separates eccentricity "

@@ -230,6 +230,15 @@ PROBE_PLANE = _define(
 RECORD_COUNT = _define(
     61416, "RECORD_COUNT", "Adapt record count _TP[]/_CVAL", "匹配区大小 _TP[ ]/_CVAL",
     "Adapt the number of probe data records.")
+# product extensions of the CYCLE996-like kinematics measurement (design.md §10.6; numbers of this
+# product, not of the manual's catalogue)
+KINEMATICS_SPHERE = _define(
+    61470, "KINEMATICS_SPHERE", "Calibration sphere: measured diameter outside the tolerance",
+    "校准球：测得的直径超出公差",
+    "Clean the calibration sphere and the probe ball, check the sphere diameter entered, measure again.")
+KINEMATICS_AXIS = _define(
+    61471, "KINEMATICS_AXIS", "Rotary axis cannot be determined from these positions", "无法由这些位置确定回转轴",
+    "Measure at 3 or more different positions of the axis, spread over a wider angle.")
 
 # --- warnings 62xxx (Cancel, the program goes on) ----------------------------------------------
 SAFE_AREA_WARNING = _define(

@@ -31,15 +31,18 @@ class MeasuringError(Exception):
     """A measurement that cannot give a result: an alarm of ``engine.alarms`` and what happened.
 
     ``alarm`` is the manual's alarm number, ``definition`` the catalogue entry (text, remedy).
+    ``result``: what was measured when a tolerance band refused the write (``_TSA``, ``_TDIF``,
+    a form-error limit; design.md §10.2), else None.
     """
 
-    def __init__(self, alarm: AlarmDef, message: str):
+    def __init__(self, alarm: AlarmDef, message: str, result: dict[str, Any] | None = None):
         if not isinstance(alarm, AlarmDef):
             raise TypeError(f"MeasuringError needs an engine.alarms entry, got {alarm!r}")
         super().__init__(f"{alarm.number}: {message}")
         self.definition = alarm
         self.alarm = alarm.number
         self.message = message
+        self.result = result
 
 
 # --- probe data -----------------------------------------------------------------------
@@ -184,7 +187,19 @@ class SpindleStep:
     label: str = ""
 
 
-Step = MoveStep | ProbeStep | SpindleStep
+@dataclass(frozen=True)
+class RotaryStep:
+    """Positioning of rotary axes (deg, rapid; design.md §10.6): a swivel head or a rotary table.
+    A head axis turns the NC's tool axis, so the tip <-> axes conversion is taken anew after it.
+    ``tip`` (MCS, only for a step to the zero position of every rotary axis): X/Y/Z move in the
+    same motion so that the NC's tool reference ends there (L along the spindle axis)."""
+
+    axes: tuple[tuple[str, float], ...]
+    label: str = ""
+    tip: FloatArray | None = None
+
+
+Step = MoveStep | ProbeStep | SpindleStep | RotaryStep
 
 
 @dataclass(frozen=True)

@@ -58,6 +58,8 @@
     if (panel.axis) headers["X-Panel-Axis"] = panel.axis;
     if (panel.increment) headers["X-Panel-Increment"] = panel.increment;
     if (panel.coords) headers["X-Panel-Coords"] = panel.coords;
+    var mode = document.getElementById("hdr-mode");        // the mode this tab's screen selects
+    if (mode && mode.dataset.selected) headers["X-Panel-Mode"] = mode.dataset.selected;
   });
   function restorePanel() {     // a page load renders the defaults: show this tab's selection
     var mcp = document.getElementById("mcp");
@@ -74,24 +76,43 @@
   }
   document.addEventListener("DOMContentLoaded", restorePanel);
 
-  // --- connection: a failed or late request, or a live feed that went quiet (static/live.js), shows
-  // that the machine is not reached (no stale "stopped"); the next answer clears it
-  var lost = false;
-  function connection(ok) {
-    if (ok === !lost) return;
-    lost = !ok;
+  // --- connection: "lost" when the live feed (static/live.js) has been quiet for 3 s or its link
+  // broke, or a request could not be sent; "busy" when answers come late (an htmx timeout, or a
+  // request on its way for over BUSY_MS) while the feed still runs. Both lie over the header (CSS):
+  // the layout never moves. The next answer or event clears them.
+  var BUSY_MS = 1500;
+  var lost = false, busy = false, pending = 0, pendingSince = 0;
+  function show() {
     document.body.classList.toggle("offline", lost);
     var banner = document.getElementById("connection");
     if (banner) banner.hidden = !lost;
+    var late = document.getElementById("busy");
+    if (late) late.hidden = lost || !busy;
   }
-  ["htmx:sendError", "htmx:timeout"].forEach(function (name) {
-    document.addEventListener(name, function () { connection(false); });
+  function connection(ok) {
+    if (ok === !lost) return;
+    lost = !ok;
+    if (ok) busy = false;
+    show();
+  }
+  function slow(yes) {
+    if (busy === yes) return;
+    busy = yes;
+    show();
+  }
+  window.hmiConnection = connection;         // the hold-to-run renewals report a failed send
+  document.addEventListener("htmx:sendError", function () { connection(false); });
+  document.addEventListener("htmx:timeout", function () { slow(true); });
+  document.addEventListener("htmx:beforeRequest", function () {
+    if (pending++ === 0) pendingSince = Date.now();
   });
   document.addEventListener("htmx:afterRequest", function (event) {
+    pending = Math.max(0, pending - 1);
     var xhr = event.detail.xhr;
-    if (xhr && xhr.status > 0 && xhr.status < 500) connection(true);
+    if (xhr && xhr.status > 0 && xhr.status < 500) { connection(true); slow(false); }
     else if (xhr && xhr.status >= 500) connection(false);
   });
+  setInterval(function () { if (pending > 0 && Date.now() - pendingSince > BUSY_MS) slow(true); }, 250);
   // the live feed (static/live.js) says when its events stop and come back
   document.addEventListener("hmi:connection", function (event) { connection(event.detail.ok); });
   document.addEventListener("htmx:responseError", function (event) {    // 4xx/5xx: say why
@@ -243,7 +264,8 @@
     var headers = csrfHeaders();
     headers["Content-Type"] = "application/x-www-form-urlencoded";
     return fetch(url, { method: "POST", body: new URLSearchParams(values).toString(), headers: headers,
-                        credentials: "same-origin", keepalive: true }).catch(function () {});
+                        credentials: "same-origin", keepalive: true })
+      .catch(function () { connection(false); });
   }
   function release() {
     if (!holding) return;

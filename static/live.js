@@ -1,11 +1,13 @@
 // The live feed (GET /api/events, design.md §9.9) in place of polling: the position values are
 // written straight from each "machine" event; the header, the position block, the alarm pane and
 // anything listening for "hmi-state" (machine) or "hmi-session" (measuring session) are refreshed
-// by htmx when that state changes. A feed quiet for WATCHDOG_MS shows the connection as lost
-// (the server sends the state at least 4 times a second).
+// by htmx when that state changes; the position title follows the active WO at once, and a change
+// of the screens' units (the settings, by any tab or the API) draws the screen again. A feed quiet
+// for WATCHDOG_MS, or a broken link, shows the connection as lost (the server sends the state at
+// least 4 times a second; a late answer alone is "busy", static/hmi.js).
 (function () {
   "use strict";
-  var WATCHDOG_MS = 1000;
+  var WATCHDOG_MS = 3000;
   var url = document.body && document.body.dataset.events;
   if (!url || !window.EventSource) return;
 
@@ -26,6 +28,24 @@
   function fixed(value, decimals) {         // as app/web/templating.py fixed(): no "-0.000"
     var text = value.toFixed(decimals);
     return parseFloat(text) === 0 ? (0).toFixed(decimals) : text;
+  }
+  function showOffset(state) {
+    document.querySelectorAll("#position .pos-wo").forEach(function (wo) {
+      if (state.active_offset && wo.textContent !== state.active_offset) wo.textContent = state.active_offset;
+    });
+  }
+  // the units of the page (body data-units) differ from the settings': every number of the screen is
+  // in the old unit, so the screen is drawn again (the position block follows "hmi-state")
+  var unitsAsked = null;
+  function followUnits(state) {
+    var body = document.body;
+    if (!state.units || body.dataset.units === state.units || unitsAsked === state.units) return;
+    unitsAsked = state.units;
+    var screen = document.getElementById("screen");
+    var done = function () { body.dataset.units = state.units; unitsAsked = null; };
+    if (!screen) { done(); return; }
+    htmx.ajax("GET", window.location.pathname + window.location.search, { target: "#screen", swap: "outerHTML" })
+      .then(done, function () { unitsAsked = null; });
   }
   function showPositions(state) {
     var box = document.getElementById("position-values");
@@ -76,7 +96,7 @@
   }
   // what the header, the position block's T/F/SP/State table, the alarm pane and the probe pane show
   function machineSignature(s) {
-    return JSON.stringify([s.mode, s.active_offset, s.plane, s.tool, s.tool_length, s.feed_override,
+    return JSON.stringify([s.mode, s.active_offset, s.plane, s.units, s.tool, s.tool_length, s.feed_override,
                            s.spindle_angle, s.busy, s.program_state, s.alarms, s.probe, s.tool_probe]);
   }
   function sessionSignature(s) {
@@ -124,6 +144,8 @@
     seen();
     var state = JSON.parse(event.data);
     showPositions(state);
+    showOffset(state);
+    followUnits(state);
     showLock(state);
     showProbes(state);
     var sig = machineSignature(state);
@@ -135,6 +157,9 @@
     lastSession = sessionSignature(JSON.parse(event.data));
     sessionSig = changed(sessionSig, lastSession, "hmi-session");
   });
-  source.addEventListener("error", function () { machineSig = sessionSig = lastSession = null; });
+  source.addEventListener("error", function () {          // the link broke (the browser reconnects)
+    machineSig = sessionSig = lastSession = null;
+    if (source.readyState !== EventSource.OPEN) connection(false);
+  });
   window.addEventListener("pagehide", function () { source.close(); });
 })();

@@ -18,6 +18,7 @@ from . import (
     access,
     data,
     events,
+    kinematics,
     lathe,
     machine,
     measure,
@@ -58,7 +59,8 @@ ERRORS: dict[int | str, dict[str, Any]] = {"4XX": {"model": ErrorEnvelope, "desc
                                                          "415 non-JSON body, 422 validation"}}
 api_router = APIRouter(prefix="/api", generate_unique_id_function=operation_id, dependencies=[Depends(guard)],
                        responses=ERRORS)
-for module in (machine, data, measure, setup_support, plc, access, nc, programs, lathe, events, results, probe_test, plant):
+for module in (machine, data, measure, setup_support, plc, access, nc, programs, lathe, events, results, probe_test, plant,
+               kinematics):
     for route in module.router.routes:
         if isinstance(route, APIRoute) and route.summary is None:
             route.summary = route.endpoint.__name__.replace("_", " ").title()    # FastAPI's default

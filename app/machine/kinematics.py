@@ -26,6 +26,7 @@ Decisions (where the spec leaves room):
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -117,9 +118,10 @@ class Kinematics:
         return np.zeros(3) if moved is None else moved[1]
 
     # --- the control's kinematic data (machine data, design.md §10.6) ---------------------
-    def nc_lines(self) -> dict[str, dict[str, list[float]]]:
-        """The axis lines the NC holds (head and table), ``{axis: {"point", "direction"}}``."""
-        return {a: {"point": [float(v) for v in p], "direction": [float(v) for v in d]}
+    def nc_lines(self) -> dict[str, dict[str, Any]]:
+        """The axis lines the NC holds (head and table), ``{axis: {"point", "direction", "unit"}}``."""
+        units = {**{a: "head" for a in self._nc_lines}, **{a: "table" for a in self._nc_table}}
+        return {a: {"point": [float(v) for v in p], "direction": [float(v) for v in d], "unit": units[a]}
                 for a, (p, d) in {**self._nc_lines, **self._nc_table}.items()}
 
     def set_nc_lines(self, lines: dict) -> None:

@@ -11,7 +11,7 @@ tool reference point (spindle nose). Probing directions are unit vectors in MCS.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Protocol, runtime_checkable
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -225,7 +225,7 @@ class KinematicData(Protocol):
     ``{axis: {"point": [x, y, z], "direction": [dx, dy, dz]}}`` at the zero position of every
     rotary axis (head axes relative to the tool reference point, a table's in MCS)."""
 
-    def kinematic_data(self) -> dict[str, dict[str, list[float]]]: ...
+    def kinematic_data(self) -> dict[str, dict[str, Any]]: ...
 
     def write_kinematic_data(self, lines: dict) -> None:
         """Replace the lines of the axes given (others keep theirs); ValueError names a bad axis."""

@@ -27,6 +27,8 @@ Decisions of the milling machine (where the spec leaves room):
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from engine import alarms
@@ -150,7 +152,7 @@ class SimulatedMachine(SimulatedControl):
                                             "would turn the tool into the workpiece"))
 
     # --- kinematic data (KinematicData, design.md §10.6) ----------------------------------
-    def kinematic_data(self) -> dict[str, dict[str, list[float]]]:
+    def kinematic_data(self) -> dict[str, dict[str, Any]]:
         with self._lock:
             return self._kinematics.nc_lines()
 

@@ -56,8 +56,9 @@ from .modal import (
     infeed_unit,
 )
 from .offsets import MeasuringOffsetError, MeasuringOffsets, NoMeasuredValue
-from .parser import find_jump, parse_program
+from .parser import find_jump, parse_program, refuse_out_of_scope
 from .runtime import MeasureResult, NcRuntime
+from .scope import refusal
 from .variables import CallbackBacking, VarDef, VariableError, Variables
 
 CycleHandler = Callable[["CycleContext"], None]
@@ -390,6 +391,8 @@ class Interpreter:
         with self._lock:
             if self._state == _RUNNING:
                 raise NcStateError("a program is running: stop it before loading another")
+        if isinstance(program, str):
+            refuse_out_of_scope(program)
         parsed = parse_program(program, name) if isinstance(program, str) else program
         try:
             self.variables.define_locals(_local_definitions(parsed, self.variables))
@@ -906,8 +909,8 @@ class Interpreter:
             raise NcSyntaxError(f"{w.axis}: this machine has no axis {w.axis} (axes: {' '.join(sorted(axes))})",
                                 w.pos.line, w.pos.column, alarm=alarms.NC_NAME_UNKNOWN)
         if isinstance(w, n.CycleCall) and w.name not in self.cycles:
-            raise NcSyntaxError(f"{w.name} is not a cycle of this control"
-                                + (f" (known: {', '.join(sorted(self.cycles))})" if self.cycles else ""),
+            raise NcSyntaxError(refusal(w.name) or (f"{w.name} is not a cycle of this control"
+                                + (f" (known: {', '.join(sorted(self.cycles))})" if self.cycles else "")),
                                 w.pos.line, w.pos.column, alarm=alarms.NC_NAME_UNKNOWN)
         if isinstance(w, n.Assign):
             self._check_var(w.target, write=True)
@@ -956,8 +959,8 @@ class Interpreter:
             hint = ""
             if var.name in GEOMETRY_AXES or len(var.name) == 1:
                 hint = " (an axis is only an index here, e.g. $AA_MM[X])"
-            raise NcSyntaxError(f"{var.name} is not a known variable{hint}; define local variables with DEF",
-                                var.pos.line, var.pos.column, alarm=alarms.NC_NAME_UNKNOWN)
+            raise NcSyntaxError(refusal(var.name) or f"{var.name} is not a known variable{hint}; define local "
+                                "variables with DEF", var.pos.line, var.pos.column, alarm=alarms.NC_NAME_UNKNOWN)
         return self.variables.definition(var.name)
 
 

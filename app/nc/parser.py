@@ -10,6 +10,7 @@ cycles are checked later against the variable store and the cycle registry
 
 from __future__ import annotations
 
+import re
 from bisect import bisect_left, bisect_right
 from collections.abc import Callable
 from functools import lru_cache
@@ -31,6 +32,7 @@ from .modal import (
     MOTION,
     g_group,
 )
+from .scope import OUT_OF_SCOPE, refusal
 
 #: how a terminal is named in an error message
 _TERMINAL_WORDS = {
@@ -413,6 +415,10 @@ MAX_NESTING = 32
 MAX_PROGRAM_BYTES = 1024 * 1024
 
 
+#: ``;`` and the fullwidth ``；`` the Chinese manual prints in its listings (chapter 6)
+COMMENT_STARTS = (";", "\uff1b")
+
+
 def _scan_line(line: str, number: int) -> None:
     """What the grammar cannot bound: the block's length, its nesting, and ASCII outside the
     texts in quotes and the comment (a fullwidth digit is no digit of the NC: ``X１２``)."""
@@ -422,6 +428,8 @@ def _scan_line(line: str, number: int) -> None:
                             block_text=line[:80])
     if line.isascii() and "(" not in line and "[" not in line:
         return
+    if line.lstrip().startswith("%"):
+        return              # the program name line (a file name, not a block: the manual prints %_N_斜面测量_MPF)
     depth = 0
     quoted = False
     for column, ch in enumerate(line, start=1):
@@ -429,7 +437,7 @@ def _scan_line(line: str, number: int) -> None:
             quoted = not quoted
         elif quoted:
             continue
-        elif ch == ";":
+        elif ch in COMMENT_STARTS:
             return
         elif not ch.isascii():
             raise NcSyntaxError(f"unexpected character '{ch}' (U+{ord(ch):04X}): the NC reads ASCII letters, "
@@ -443,6 +451,23 @@ def _scan_line(line: str, number: int) -> None:
                                     block_text=line.strip())
         elif ch in ")]":
             depth -= 1
+
+
+_OUT_OF_SCOPE = re.compile(r"(?<![$\w])(" + "|".join(re.escape(w) for w in OUT_OF_SCOPE) + r")(?!\w)", re.IGNORECASE)
+
+
+def refuse_out_of_scope(text: str) -> None:
+    """A word of the manual this control does not run (app.nc.scope) names itself, wherever it
+    stands in the program, before any other complaint (``CYCLE800(1,““,...)`` of manual §5.7.2):
+    what ``Interpreter.load`` checks first; the grammar itself still reads such words."""
+    for number, line in enumerate(text.replace("\r\n", "\n").replace("\r", "\n").split("\n"), start=1):
+        if line.lstrip().startswith("%"):
+            continue
+        code = line.split(";", 1)[0].split("\uff1b", 1)[0]
+        match = _OUT_OF_SCOPE.search(code)
+        if match is not None:
+            raise NcSyntaxError(refusal(match.group(0)) or match.group(0), number, match.start() + 1,
+                                alarm=alarms.NC_NAME_UNKNOWN, block_text=line.strip())
 
 
 def parse_program(text: str, name: str = "MDA") -> n.Program:

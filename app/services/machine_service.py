@@ -160,6 +160,7 @@ class MachineService:
         """The ``GET /api/machine`` body (design.md §4) plus channel, tool length, program state."""
         st = self._machine.status()
         self._see_alarms(st)
+        settings = self._settings.get()
         alarms = [alarm_dict(a) for a in st.alarms]
         program_state = "active" if st.busy else ("interrupted" if alarms else "reset")
         return {
@@ -168,7 +169,8 @@ class MachineService:
             "mcs": {a: float(v) for a, v in st.mcs.items()},
             "wcs": self.wcs_from_mcs(st.mcs, st.tool_length),
             "active_offset": self._active_offset,
-            "plane": self._settings.get().plane,
+            "plane": settings.plane,
+            "units": settings.units,        # the screens' units (design.md §9.9): the live feed carries a change
             "tool": st.tool,
             "tool_length": float(st.tool_length),
             "feed_override": float(st.feed_override),

@@ -8,7 +8,8 @@ from pydantic import ValidationError
 
 from app.access.checks import check_actor
 from app.errors import InvalidInput
-from app.machine.protocol import Alarm, Machine
+from app.machine.protocol import Alarm, KinematicData, Machine
+from app.machine.scenario import Scenario
 from app.records import ToolData, frame_out_of_range, is_probe_tool
 from app.services.lathe_data import STATE_GROOVES
 from app.services.machine_service import MachineService
@@ -138,6 +139,7 @@ class MeasuringEnv:
             probe=probe,
             probe_data=probe_data,
             extra={"tool_probe": tool_probe, "tool_probe_number": int(gud.tool_probe_number),
+                   "kinematics": self.kinematic_facts(),
                    "probe_number": probe_no, "active_is_g500": active == G500,
                    **({"lathe": self._lathe_extra(st, lathe)} if lathe is not None else {})},
         )
@@ -155,7 +157,8 @@ class MeasuringEnv:
                               self._settings.get())
 
     def commit_measurement(self, *, offset: OffsetChange | None = None, log_entry: dict, probe_update=None,
-                           tool_update=None, tool_probe_update=None, tool_offset: ToolOffsetChange | None = None
+                           tool_update=None, tool_probe_update=None, tool_offset: ToolOffsetChange | None = None,
+                           kinematics_update: dict | None = None
                            ) -> tuple[int, OffsetOutcome | ToolOffsetOutcome | None]:
         """Offset + audit + log (+ probe/tool records) in one transaction (design.md §6, §9.1).
 
@@ -170,13 +173,26 @@ class MeasuringEnv:
         functions = [f for f, writes in (("offsets", offset is not None),
                                          ("calibration", calibration),
                                          ("tools", (tool_update is not None or tool_offset is not None)
-                                          and not calibration)) if writes]
+                                          and not calibration),
+                                         # the control's kinematic data are machine data (design.md §10.6)
+                                         ("settings", kinematics_update is not None)) if writes]
         with acting_as(current_actor() or self._start_actor):
             check_actor(self._settings, functions)
             return self._commit(offset, log_entry, probe_update, tool_update, tool_probe_update, tool_offset,
-                                "calibration" if calibration else "measure")
+                                "calibration" if calibration else "measure", kinematics_update)
 
-    def _commit(self, offset, log_entry, probe_update, tool_update, tool_probe_update, tool_offset, source):
+    def kinematic_facts(self) -> dict:
+        """What ``kinematics.measure`` needs of the machine: the control's axis lines (with their
+        unit), the rotary axes, their limits (app.workflow.kinematics_task)."""
+        machine = self._ms.machine
+        lines = machine.kinematic_data() if isinstance(machine, KinematicData) else {}
+        scenario = self._ms.scenario
+        limits = scenario.limits() if isinstance(scenario, Scenario) else {}
+        return {"lines": lines, "rotary_axes": self._ms.rotary_axes,
+                "limits": {a: tuple(v) for a, v in limits.items() if a in lines}}
+
+    def _commit(self, offset, log_entry, probe_update, tool_update, tool_probe_update, tool_offset, source,
+                kinematics_update=None):
         entry = {k: v for k, v in log_entry.items() if k in LOG_FIELDS}
         outcome = stored_offset = stored_tool = None
         generation = self._db.generation
@@ -199,15 +215,20 @@ class MeasuringEnv:
                 if outcome.after is not None:
                     tool_update = (outcome.tool, outcome.after)
             if probe_update is not None:
-                record = self._calibrated(unit, "workpiece", *probe_update, entry)
+                record = self._calibrated(unit, "workpiece", probe_update[0], probe_update[1], entry)
                 unit.put_probe(probe_update[0], record, source=source, detail=detail)
             if tool_update is not None:
                 stored_tool = unit.put_tool(tool_update[0], tool_update[1], source=source, detail=detail)
             if tool_probe_update is not None:
-                record = self._calibrated(unit, "tool", *tool_probe_update, entry)
+                record = self._calibrated(unit, "tool", tool_probe_update[0], tool_probe_update[1], entry)
                 unit.put_tool_probe(tool_probe_update[0], record, source=source, detail=detail)
             log_id = self.results.add_log(unit, entry) if self.results is not None else unit.add_log(entry)
+            lines = self._kinematics_audit(unit, kinematics_update, log_id)
         log_entry["calibration_id"] = entry.get("calibration_id")     # a calibration's new id, for the answer
+        if lines is not None:                  # the NC holds what the audit says
+            machine = self._ms.machine
+            assert isinstance(machine, KinematicData), "kinematic_facts found the lines on this machine"
+            machine.write_kinematic_data(lines)
         if stored_offset is not None and not (probe_update or tool_update or tool_probe_update):
             self._written(generation, *stored_offset)
         if stored_offset is not None:          # the NC holds what was stored
@@ -227,6 +248,19 @@ class MeasuringEnv:
         entry["calibration_id"] = event["id"]
         return {**record, "calibration_id": event["id"], "invalidated": None,
                 "probe_identity": self._ms.probe_identity(probe)}
+
+    def _kinematics_audit(self, unit, update: dict | None, log_id: int) -> dict | None:
+        """The audit row of a kinematics write (kind "kinematics", undoable); the lines to write."""
+        if update is None:
+            return None
+        machine = self._ms.machine
+        if not isinstance(machine, KinematicData):
+            raise MeasuringError(alarms.ROTARY_AXIS, "this controller holds no rotary-axis kinematic data")
+        before = machine.kinematic_data()
+        after = {a: ({**line, **update[a]} if a in update else line) for a, line in before.items()}
+        unit.add_audit("kinematics", "kinematics", before, after, "measure",
+                       {"task": "kinematics.measure", "log_id": log_id})
+        return update
 
     def _frames_in(self, unit, generation: int) -> dict[str, Frame]:
         """The stored frames inside the write transaction: the cached ones when nothing was

@@ -2,7 +2,7 @@
 jog-measuring §9.2): the value before that change is written again, as a new audited write (source "undo",
 detail ``{"undo_of": id}``), by the service that owns the data so that the NC gets it too.
 
-Undoable: zero offsets, tools, workpiece and tool probe records. Not undoable (409
+Undoable: zero offsets, tools, workpiece and tool probe records, rotary-axis kinematic data. Not undoable (409
 ``not_undoable``): memories, settings, scenario loads, users, tokens, keyswitch: write them again.
 """
 
@@ -12,7 +12,7 @@ from app.errors import ConflictError
 
 # the access function an undo of each kind needs (app/access/levels.py)
 UNDO_FUNCTION = {"offset": "offsets", "tool": "tools", "probe": "probe_data", "tool_probe": "probe_data",
-                 "memory": "offsets", "settings": "settings"}
+                 "memory": "offsets", "settings": "settings", "kinematics": "settings"}
 
 
 def undo(services, entry: dict, force: bool = False) -> dict:
@@ -25,5 +25,9 @@ def undo(services, entry: dict, force: bool = False) -> dict:
         return services.probes.restore(entry, force)
     if kind == "tool_probe":
         return services.tool_probes.restore(entry, force)
+    if kind == "kinematics":
+        from .kinematics import KinematicsService
+
+        return KinematicsService(services.db, services.machine).restore(entry, force)
     raise ConflictError(f"a change of kind {kind!r} cannot be undone here: write the value again",
                         code="not_undoable")

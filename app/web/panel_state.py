@@ -22,9 +22,11 @@ class PanelState:
     feed: str = ""            # jog feed, mm/min ("" = the machine's own jog feed, SD 41110 JOG_SET_VELO)
     rapid: bool = False       # the RAPID key: jog at rapid traverse times the rapid override
     rov: str = "25"           # rapid override, percent
+    mode: str = ""            # the mode the tab's screen selects (JOG/MDA/AUTO; "" = the page's own)
     INCREMENTS: ClassVar[dict[str, float | None]] = {"1": 0.001, "10": 0.01, "100": 0.1, "1000": 1.0, "cont": None}
     FEEDS: ClassVar[tuple[str, ...]] = ("", "100", "250", "500", "1000", "2000", "5000")
     RAPID_OVERRIDES: ClassVar[tuple[str, ...]] = ("1", "5", "25", "50", "100")
+    MODES: ClassVar[tuple[str, ...]] = ("JOG", "MDA", "AUTO")
 
     @classmethod
     def of(cls, request: Request, axes) -> PanelState:
@@ -34,12 +36,14 @@ class PanelState:
         coords = headers.get("X-Panel-Coords", cls.coords)
         feed = headers.get("X-Panel-Feed", cls.feed)
         rov = headers.get("X-Panel-Rov", cls.rov)
+        mode = headers.get("X-Panel-Mode", cls.mode)
         return cls(axis=axis if axis in axes else cls.axis,
                    increment=increment if increment in cls.INCREMENTS else cls.increment,
                    coords=coords if coords in ("WCS", "MCS") else cls.coords,
                    feed=feed if feed in cls.FEEDS else cls.feed,
                    rapid=headers.get("X-Panel-Rapid") == "on",
-                   rov=rov if rov in cls.RAPID_OVERRIDES else cls.rov)
+                   rov=rov if rov in cls.RAPID_OVERRIDES else cls.rov,
+                   mode=mode if mode in cls.MODES else cls.mode)
 
     def jog_feed(self, rapid_traverse: float, rapid: bool | None = None) -> float | None:
         """mm/min of a jog: the chosen jog feed, or with RAPID the rapid traverse times the rapid

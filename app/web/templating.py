@@ -18,6 +18,7 @@ from fastapi import Request
 from fastapi.responses import HTMLResponse
 from jinja2 import pass_context
 from jinja2_fragments.fastapi import Jinja2Blocks
+from markupsafe import escape
 from starlette.routing import NoMatchFound
 
 from app import i18n
@@ -233,7 +234,27 @@ def render_screen(request: Request, template: str, context: dict | None = None, 
     if not is_htmx(request):
         ctx = _context(request, context)
         return templates.TemplateResponse(request, template, ctx, status_code=status_code)
-    return render_blocks(request, template, SCREEN_BLOCKS, context, status_code)
+    ctx = _context(request, context)
+    html = "".join(jinja2_fragments.render_block(templates.env, _owner(template, block), block, ctx)
+                   for block in SCREEN_BLOCKS)
+    title, mode = _screen_chrome(template, ctx)
+    return HTMLResponse(title + html + mode, status_code=status_code)
+
+
+def _screen_chrome(template: str, ctx: dict) -> tuple[str, str]:
+    """What comes with the screen on an htmx navigation besides its blocks: the page title (first:
+    htmx takes a top-level ``<title>`` only if it is the answer's first one) and the header's mode
+    (the mode the screen selects, out of band)."""
+    def block(name: str) -> str:
+        return jinja2_fragments.render_block(templates.env, _owner(template, name), name, ctx).strip()
+
+    title = f"<title>{block('title')} · {escape(i18n.gettext('Measure-in-JOG HMI'))}</title>"
+    status = ctx["status"]
+    selected = block("mode")
+    shown = status["mode"] if status.get("mode", "JOG") != "JOG" else selected
+    mode = (f'<span class="mode" id="hdr-mode" data-selected="{escape(selected)}" hx-swap-oob="true" '
+            f'title="{escape(i18n.gettext("operating mode"))}">{escape(shown)}</span>')
+    return title, mode
 
 
 def render_blocks(request: Request, template: str, blocks: list[str], context: dict | None = None,

@@ -117,7 +117,8 @@ class WorkflowEnv(Protocol):
                            probe_update: tuple[int, dict] | None = None,
                            tool_update: tuple[int, dict] | None = None,
                            tool_probe_update: tuple[int, dict] | None = None,
-                           tool_offset: ToolOffsetChange | None = None
+                           tool_offset: ToolOffsetChange | None = None,
+                           kinematics_update: dict | None = None
                            ) -> tuple[int, OffsetOutcome | ToolOffsetOutcome | None]:
         """Offset + audit + log (+ data records) in one transaction; (log id, what was decided)."""
 

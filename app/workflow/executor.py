@@ -15,7 +15,7 @@ import numpy as np
 from app.machine.protocol import Alarm, Machine, MachineAlarm
 from engine.coords import GEOMETRY_AXES, LatheToolTip, ToolTip, head_shift_of, length_axis
 from engine.frames import Frame
-from engine.types import Latch, MoveStep, ProbeStep, SpindleStep, Step
+from engine.types import Latch, MoveStep, ProbeStep, RotaryStep, SpindleStep, Step
 
 
 class MotionAborted(Exception):
@@ -82,6 +82,19 @@ class StepExecutor:
             latched = np.array([probed.latched_mcs[a] for a in GEOMETRY_AXES])
             rec = self.tip_conversion.tip_in(latched, step.coords)
             return Latch(triggered=True, rec=rec, latched_mcs=latched)
+        if isinstance(step, RotaryStep):
+            target = dict(step.axes)
+            if step.tip is not None:          # to the zero position: tip = A − L·spindle axis
+                if any(abs(v) > 1e-12 for v in target.values()):
+                    raise ValueError("RotaryStep.tip: only with every rotary axis at 0")
+                axes = np.asarray(step.tip, dtype=float) + float(self.tool_length) * np.asarray(self.infeed_unit)
+                target.update({a: float(v) for a, v in zip(GEOMETRY_AXES, axes, strict=True)})
+            result = self.machine.goto(target, None)
+            if not result.completed:
+                self._raise_for(result.alarm)
+            if self._own_tip:                 # a head axis turned the NC's tool axis (design.md §10.6)
+                self.tip = self._milling_tip()
+            return None
         if isinstance(step, SpindleStep):
             if step.angle is not None:
                 self.machine.spindle_position(step.angle)

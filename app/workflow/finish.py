@@ -29,12 +29,20 @@ def setpoints_of(session: MeasureSession, plane_axes: tuple[str, ...]) -> dict[s
     return {a: float(raw) for a in plane_axes[:2]}
 
 
+class FormErrorRefusal(WorkflowError):
+    """409 ``form_error`` that keeps what was measured (design.md §10.2): ``extra.result``."""
+
+    def __init__(self, values: dict, message: str, field: str):
+        super().__init__(409, "form_error", message, field)
+        self.extra["result"] = dict(values)
+
+
 def check_form_error(params: dict, values: dict) -> None:
     """``params.max_form_error`` refuses the write above it (design.md §9.8); nothing is written."""
     limit = params.get("max_form_error")
     form_error = values.get("form_error")
     if limit is not None and form_error is not None and form_error > limit:
-        raise WorkflowError(409, "form_error", f"Form error {form_error:.4f} mm of the fitted points is above "
+        raise FormErrorRefusal(values, f"Form error {form_error:.4f} mm of the fitted points is above "
                             f"the limit {limit:g} mm: nothing written. Check the points (a chip, a burr?) "
                             "and measure again", "max_form_error")
 

@@ -109,9 +109,14 @@ def finish_tool_offset(session: MeasureSession, ctx: MeasuringContext, points: l
         decision = decide_tool_offset(actual, tolerance, ev=ev, mv_old=mv_old, ev_add=settings.ev_add)
         action = repeat_measurement(decision.violation, repetitions, repeat=settings.repeat_on_violation)
         alarm = action.alarm if decision.violation else decision.alarm
+        measured = {**result.values, "deviation": decision.deviation, "mean_value": decision.mean_value,
+                    "decision": decision.decision, "actual": decision.actual, "setpoint": decision.setpoint,
+                    "upper": decision.upper, "lower": decision.lower, "feature": feature}
         if action.abort:        # 61303 / 61306: the cycle aborts, nothing is written (measuring-math §3.5, measuring-math §3.6)
             assert action.alarm is not None, "an aborting repeat action carries its alarm"
-            raise MeasuringError(action.alarm, f"{_words(decision)}: no correction")
+            # the refusal keeps what was measured (design.md §10.2): the 409 and the log carry it
+            raise MeasuringError(action.alarm, f"{_words(decision)}: no correction",
+                                 result={**measured, "alarm": {"code": action.alarm.number, "text": action.alarm.text}})
         update = tool_offset_update(tool_row, decision, feature, correct=target["correct"], mode=target["mode"],
                                     direction=direction)
         writes = {}

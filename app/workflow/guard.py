@@ -36,7 +36,7 @@ def protection_data(machine) -> dict | None:
 
 def guarded(spec) -> bool:
     """Workpiece-probe tasks in the WCS are checked; tool measuring and the lathe are not."""
-    return bool(spec.needs_probe) and not getattr(spec, "lathe", False)
+    return bool(spec.needs_probe) and not getattr(spec, "lathe", False) and bool(getattr(spec, "guarded", True))
 
 
 def check_point(machine, spec, params: dict, n: int, ctx) -> tuple[GuardReport, str]:

@@ -32,7 +32,9 @@ from app.workflow.session import MeasureSession, stored_point_to_api
 from app.workflow.tasks import TASKS, Category, Target, TaskSpec, task_spec
 from db import StorageUnavailable
 from engine import alarms
+from engine.frames import chain_of, is_basic
 from engine.plan import ideal_path, run_program
+from engine.planes import axis_index
 from engine.strategy import Tolerance
 from engine.tasks import evaluate
 from engine.types import MeasuringError, averaged, translated
@@ -110,6 +112,10 @@ class WorkflowService:
             normalised, chosen = self._params_with_target(spec, params, target, ctx)
         else:
             normalised = self._validate(spec, params, ctx)
+            try:
+                spec.check_machine(normalised, self._env)
+            except ValueError as exc:
+                raise WorkflowError(400, "invalid_param", str(exc), getattr(exc, "field", None)) from exc
             self._check_rotary_axis(normalised)
             chosen = target or ctx.active_offset
             if chosen == "G500" and spec.corrects_zero_offset:
@@ -409,15 +415,21 @@ class WorkflowService:
             answer.update(self._finish(session, spec))
             if not answer.get("_repeat"):
                 answer.pop("_repeat", None)
-                if session.params.get("verify") and answer.get("activated"):
-                    answer["verify"] = self._verify(spec, session, n)
+                if session.params.get("verify"):
+                    answer["verify"] = self._verify(spec, session, n, answer)
                     session.last = {**(session.last or {}), "verify": answer["verify"]}
                 return answer
             session.repetitions += 1        # the repeat rule (_CBIT[0], measuring-math §3.6): measure again
 
-    def _verify(self, spec: TaskSpec, session: MeasureSession, n: int) -> dict:
-        """``params.verify`` (design.md §9.8): probe the point again in the WCS just written and
-        activated, and report what remains of the deviation from the setpoints (nothing written)."""
+    def _verify(self, spec: TaskSpec, session: MeasureSession, n: int, answer: dict) -> dict:
+        """``params.verify`` (design.md §9.8, §10.2): probe the point again and report what remains
+        of the deviation from the setpoints in the frame just written, whether it is active or not
+        (the point is measured in the active WCS and expressed, through the BCS, in the written
+        one); nothing written. Always a key: ``{"skipped": reason}`` when there is nothing to check."""
+        reason = verify_skipped(session.target, answer)
+        if reason is not None:
+            return {"skipped": reason}
+        target = str(session.target)
         ctx = self._env.measuring_context()
         try:
             point, _raw = self._measure_point(spec, session, n, ctx, count_steps=False)
@@ -427,18 +439,43 @@ class WorkflowService:
             session.progress = None
         result = evaluate(session.task, session.params, [point], ctx.plane, ctx.probe)
         setpoints = setpoints_of(session, ctx.plane.axes)
-        remaining = {axis: float(value) - setpoints.get(axis, 0.0) for axis, value in result.fix.position.items()}
-        return {"ok": True, "result": result.values, "remaining": remaining, "wcs": ctx.active_offset}
+        position = dict(result.fix.position)
+        if target != ctx.active_offset and not is_basic(target):
+            if result.fix.point is None:
+                return {"skipped": f"{session.task} gives no point to express in the inactive {target}"}
+            # p_target = (target WCS -> BCS)⁻¹ · (active WCS -> BCS) · p_active
+            in_target = chain_of(ctx.offsets, target).p_in_wcs(ctx.chain().p_in_bcs(result.fix.point))
+            position = {axis: float(in_target[axis_index(axis)]) for axis in position}
+        remaining = {axis: float(value) - setpoints.get(axis, 0.0) for axis, value in position.items()}
+        return {"ok": True, "result": result.values, "remaining": remaining, "wcs": target,
+                "measured_in": ctx.active_offset}
 
     def _alarm(self, session: MeasureSession, exc: Exception) -> WorkflowError:
         """The alarm that ended the point: kept in the session, shown by the machine, logged."""
         session.last_alarm = self._alarm_of(exc)
         if isinstance(exc, MeasuringError):
             self._env.post_alarm(exc.alarm, exc.message)
-        self._log_failure(session)
-        return WorkflowError(409, "alarm", f"{session.last_alarm['code']} {session.last_alarm['text']}")
+        result = exc.result if isinstance(exc, MeasuringError) else None
+        self._log_failure(session, result)
+        refusal = WorkflowError(409, "alarm", f"{session.last_alarm['code']} {session.last_alarm['text']}")
+        if result is not None:          # _TSA / _TDIF: the measured values and the decision (design.md §10.2)
+            refusal.extra["result"] = result
+        return refusal
 
-    def _log_failure(self, session: MeasureSession) -> None:
+    def _log_refusal(self, session: MeasureSession, code: str, message: str, result: dict) -> None:
+        entry = {
+            "task": session.task, "params": session.params, "measuring_wo": session.measuring_wo,
+            "target": target_label(session.target) if isinstance(session.target, dict) else session.target,
+            "status": f"refused {code}", "result": {**result, "refusal": {"code": code, "text": message}},
+            "points": {f"P{s.n}": stored_point_to_api(s.point) for s in session.slots},
+            "warnings": session.warnings,
+        }
+        try:
+            self._env.commit_measurement(log_entry=entry)
+        except StorageUnavailable:
+            pass
+
+    def _log_failure(self, session: MeasureSession, result: dict | None = None) -> None:
         """A failed attempt is a log entry too (status "alarm NNNNN"): which point, which step, why.
         Nothing else is written; a log that cannot be written leaves the alarm standing alone."""
         progress = session.progress or {}
@@ -447,7 +484,8 @@ class WorkflowService:
             "task": session.task, "params": session.params, "measuring_wo": session.measuring_wo,
             "target": target_label(session.target) if isinstance(session.target, dict) else session.target,
             "status": f"alarm {alarm.get('code', '')}".strip(),
-            "result": {"alarm": {**alarm, "point": progress.get("point"), "step": progress.get("label") or None}},
+            "result": {**(result or {}),
+                       "alarm": {**alarm, "point": progress.get("point"), "step": progress.get("label") or None}},
             "points": {f"P{s.n}": stored_point_to_api(s.point) for s in session.slots},
             "warnings": session.warnings,
             "calibration_id": self._calibration_id(session),
@@ -595,6 +633,10 @@ class WorkflowService:
             answer, commit = spec.finish(session, ctx, points)
         except MeasuringError as exc:
             raise self._alarm(session, exc) from exc
+        except WorkflowError as exc:
+            if "result" in exc.extra:          # a refusal by a band keeps its measurement in the log
+                self._log_refusal(session, exc.code, exc.message, exc.extra["result"])
+            raise
         log_entry = {
             "task": session.task,
             "params": session.params,
@@ -638,6 +680,20 @@ class WorkflowService:
         session.clear_points()        # jog-measuring §3.1 step 6: ready for a new measurement
         session.last = answer
         return answer
+
+
+def verify_skipped(target, answer: dict) -> str | None:
+    """Why ``params.verify`` cannot probe a check (design.md §10.2), or None."""
+    if not isinstance(target, str):
+        return "a tool offset is checked by measuring the next part, not by probing again"
+    if target == MEASURE_ONLY:
+        return "measure only: nothing was written to check"
+    correction = answer.get("correction") or {}
+    if correction.get("after") is None:
+        return "nothing was written"
+    if correction.get("rotary_axis"):
+        return f"the rotary axis {correction['rotary_axis']} must be positioned before the written frame can be checked"
+    return None
 
 
 def evaluation_inputs(session: MeasureSession) -> tuple[MeasuringContext, list]:

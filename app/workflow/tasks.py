@@ -15,7 +15,16 @@ from dataclasses import dataclass
 from enum import StrEnum
 
 from app.errors import WorkflowError
-from app.workflow import finish, finish_lathe, finish_probe, finish_tool, finish_tool_offset, forms, planning
+from app.workflow import (
+    finish,
+    finish_lathe,
+    finish_probe,
+    finish_tool,
+    finish_tool_offset,
+    forms,
+    kinematics_task,
+    planning,
+)
 from app.workflow.context import Finisher
 from engine.coords import LatheToolTip
 from engine.plan_base import ParamError, PlanContext
@@ -168,6 +177,11 @@ class TaskSpec:
     def repeats(self, params: dict) -> int:
         """How often the whole point program runs and is averaged (_NMSP, measuring-math §1.4)."""
         return int(params.get("measurements", 1))
+
+    guarded = True              # the start guard checks the plan before NC Start (design.md §10.1)
+
+    def check_machine(self, params: dict, env) -> None:
+        """Refusals of the params this machine decides (400 naming the field); most tasks have none."""
 
 
 @dataclass(frozen=True)
@@ -332,6 +346,39 @@ LATHE_SPECS: dict[str, TaskSpec] = {spec.name: spec for spec in [
 ]}
 assert tuple(LATHE_SPECS) == LATHE_TASKS
 TASKS.update(LATHE_SPECS)
+
+
+@dataclass(frozen=True)
+class KinematicsTaskSpec(TaskSpec):
+    """``kinematics.measure`` (design.md §10.6, app.workflow.kinematics_task): one point per position,
+    planned in MCS of the NC's ball centre; the start guard does not model swivels (not guarded)."""
+
+    guarded = False
+
+    def points_of(self, params: dict) -> int:
+        return len(params["positions"])
+
+    def coords_for(self, params: dict, plan_ctx) -> str:
+        return "MCS"
+
+    def plan_context(self, ctx, params: dict):
+        return ctx                          # the program reads the measuring context itself
+
+    def program(self, params: dict, n: int, start, ctx):
+        if not 1 <= int(n) <= self.points_of(params):
+            raise ValueError(f"{self.name} has points 1..{self.points_of(params)}, got {n}")
+        return kinematics_task.program(params, int(n), start, ctx, f"P{n}")
+
+    def repeats(self, params: dict) -> int:
+        return 1
+
+    def check_machine(self, params: dict, env) -> None:
+        kinematics_task.check_machine(params, env.measuring_context().extra.get("kinematics") or {})
+
+
+KINEMATICS_SPEC = KinematicsTaskSpec(kinematics_task.ENGINE_TASK, Category.WORKPIECE, frozenset(),
+                                     kinematics_task.finish_kinematics, kinematics_task.kinematics_form)
+TASKS[KINEMATICS_SPEC.name] = KINEMATICS_SPEC
 MILLING_TASKS = tuple(name for name in TASKS if name not in LATHE_SPECS)
 
 

@@ -21,7 +21,8 @@ def test_mda_screen_has_the_editor_keys_and_the_softkeys(client):
     for part in ('id="mda-form"', "data-ncstart", 'id="mda-text"', 'id="mda-gutter"', 'id="single-block"',
                  'id="mda-stop"', 'id="mda-reset"', 'id="nc-channel"', "MDA / AUTO", "Programs", "nc.js"):
         assert part in html, part
-    assert 'class="mode" title="operating mode">JOG<' in html
+    assert re.search(r'id="hdr-mode"[^>]*>MDA<', html)       # the mode the screen selects (issue 29)
+    assert re.search(r'id="hdr-mode"[^>]*>JOG<', client.get("/jog").text)
 
 
 def test_nc_start_single_block_highlights_the_block_and_shows_results(client):
@@ -30,7 +31,7 @@ def test_nc_start_single_block_highlights_the_block_and_shows_results(client):
     html = wait_channel(client, "stopped")
     assert re.search(r'<tr class="current" data-line="2">', html)          # N20 runs next
     assert "single block" in html
-    assert 'class="mode" title="operating mode">MDA<' in client.get("/jog").text
+    assert re.search(r'id="hdr-mode"[^>]*>MDA<', client.get("/jog").text)      # the program's mode
     for _ in range(5):                  # N20 .. N60 M30
         client.post("/mda/start", data={"text": BORE, "single_block": "on"}, headers=HX)
         client.app.state.services.nc.wait(10)

@@ -39,7 +39,7 @@ def test_type_a_program_in_mda_run_it_single_block_and_see_the_result(page, api)
     expect(page.locator('#nc-results dd[data-name="_OVR[4]"]')).to_have_text("20.0000")
     expect(page.locator('#nc-results dd[data-name="_OVR[5]"]')).to_have_text("290.0000")
     expect(page.locator('#nc-results dd[data-name="_OVI[2]"]')).to_have_text("977")
-    expect(page.locator("#header-status .mode")).to_have_text("JOG")
+    expect(page.locator("#header-status .mode")).to_have_text("MDA")      # the selected mode (issue 29)
     entry = api.get("/api/log").json()[0]
     assert entry["program"] == "MDA" and "CYCLE977" in entry["block"]
 

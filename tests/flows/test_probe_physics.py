@@ -165,7 +165,13 @@ def test_max_form_error_refuses_the_write(client):
     before = (op.offset("G54"), op.ok(op.c.get("/api/log")))
     body = op.ok(op.c.post(f"/api/measure/{session['id']}/calculate"), 409)
     assert body["error"]["code"] == "form_error" and body["error"]["field"] == "max_form_error"
-    assert (op.offset("G54"), op.ok(op.c.get("/api/log"))) == before
+    # nothing written; the refusal keeps its measurement in the answer and in the log (design.md §10.2)
+    surface = [0.05 * min(x, 200.0 - x) / 100.0 for x in XS]
+    log = op.ok(op.c.get("/api/log"))
+    assert op.offset("G54") == before[0] and log[1:] == before[1]
+    assert log[0]["status"] == "refused form_error" and log[0]["correction"] is None
+    for kept in (body["error"]["result"], log[0]["result"]):
+        assert kept["form_error"] == pytest.approx(max(surface) - min(surface), abs=2e-6)
 
 
 def test_orient_plane_with_five_points(client):
@@ -191,6 +197,37 @@ def test_verify_probes_again_in_the_new_wcs(client):
     assert verify["ok"] is True and verify["wcs"] == "G54"
     assert verify["remaining"]["X"] == pytest.approx(0.0, abs=1e-9)
     assert verify["remaining"]["Y"] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_verify_into_an_inactive_wo_checks_in_that_frame(client):
+    """design.md §10.2: G54 active, G55 written (set-up support: inactive WO). The check probes the
+    hole again in G54 and expresses it in G55 as stored now: the remaining deviation is what the
+    written G55 leaves, 0 on a noise-free probe; the truth is the hole's centre from the scenario
+    taken into G55 by the test's own frame arithmetic."""
+    op = Operator(client, scenario(rot=(0.0, 0.0, 4.0)))
+    op.load()
+    op.put_offset("G54", trans=(1.0, 2.0, 0.0))
+    op.put_offset("G55", trans=(-3.0, 7.0, 0.5), rot=(0.0, 0.0, 1.5))
+    op.activate("G54")
+    op.ball_to(op.part.mcs(30.3, 24.8, -8.0))                         # in hole 1 (truthkit HOLES[0])
+    params = {"diameter": 12.0, "verify": True, "setpoint": {"X": 5.0, "Y": -3.0}}
+    answer = op.start(op.create("hole.1", params, "G55")["id"])
+    assert answer["setup_support"] is not None and answer["activated"] is False
+    assert op.ok(op.c.get("/api/machine"))["active_offset"] == "G54"
+    truth = op.wcs_pose("G55").to_child(op.part.mcs(30.0, 25.0, -8.0))
+    assert truth[:2] == pytest.approx([5.0, -3.0], abs=1e-9)         # G55 was written right ...
+    verify = answer["verify"]                                          # ... and the check says so
+    assert verify["ok"] is True and verify["wcs"] == "G55" and verify["measured_in"] == "G54"
+    assert verify["remaining"] == {"X": pytest.approx(0.0, abs=1e-9), "Y": pytest.approx(0.0, abs=1e-9)}
+
+
+def test_verify_is_never_silent(client):
+    op = Operator(client, scenario(rot=(0.0, 0.0, 4.0)))
+    op.load()
+    op.activate("G54")
+    op.ball_to(op.part.mcs(30.3, 24.8, -8.0))
+    answer = op.start(op.create("hole.1", {"diameter": 12.0, "verify": True}, "measure_only")["id"])
+    assert answer["verify"] == {"skipped": "measure only: nothing was written to check"}
 
 
 def test_points_and_verify_only_where_they_fit(client):

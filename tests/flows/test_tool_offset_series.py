@@ -96,6 +96,11 @@ def test_worked_example_3_7_a(op):
     log_after = op.ok(op.c.get("/api/log"))                     # the failed attempt alone is logged
     assert log_after[1:] == log_before and log_after[0]["status"] == f"alarm {alarms.SAFE_AREA.number}"
     assert log_after[0]["correction"] is None
+    # the refusal keeps its measurement (design.md §10.2): the bore, D = 133.2 − 132 − EV 0.004, the decision
+    for kept in (body["error"]["result"], log_after[0]["result"]):
+        assert kept["diameter"] == pytest.approx(133.2, abs=1e-9)
+        assert kept["deviation"] == pytest.approx(1.196, abs=1e-9)
+        assert kept["decision"] == "safe_area" and kept["alarm"]["code"] == alarms.SAFE_AREA.number
 
 
 def test_the_log_records_the_decision_and_the_tool(op):

@@ -19,7 +19,10 @@ RING_TOP = (650.0, 350.0, -150.0)
 RING_D = 110.246
 
 
-def scenario(*, probe_t: int = 9, pretravel: dict | None = None, eccentricity=(0.0, 0.0)) -> dict:
+def scenario(*, probe_t: int = 9, pretravel: dict | None = None, eccentricity=(0.0, 0.0),
+             part: dict | None = None) -> dict:
+    """``part``: the workpiece ``{"origin": G54 coordinates of the part origin (top-front-left
+    corner), "size": block, "features": [...]}``; default the block for the surface listings."""
     probe = {"t": probe_t, "ball_diameter": 4.0, "length": PROBE_LENGTH, "max_deflection": 5.0,
              "eccentricity": list(eccentricity), "noise_sigma": 0.0,
              "nominal": {"length": PROBE_LENGTH + 0.2, "ball_diameter": 4.0}}
@@ -30,12 +33,20 @@ def scenario(*, probe_t: int = 9, pretravel: dict | None = None, eccentricity=(0
         "machine": {"limits": {"X": [-300, 900], "Y": [-200, 600], "Z": [-400, 300]}, "rapid": 10000,
                     "latency_s": 0.0, "time_scale": 0},
         "probe": probe,
-        "workpiece": {"pose": {"trans": [G54["block"][0] - 100.0, G54["block"][1], TOP_Z], "rot": [0.0, 0.0, 0.0]},
-                      "features": [{"type": "block", "size": [300, 150, 60]}]},
+        "workpiece": _workpiece(part),
         "ring_gauge": {"center": list(RING_TOP), "diameter": RING_D, "height": 30},
         "tools": [{"t": 1, "type": 120, "length": 85.0, "radius": 5.0}],
         "start": {"X": 0.0, "Y": 0.0, "Z": 250.0},
     })
+
+
+def _workpiece(part: dict | None) -> dict:
+    if part is None:
+        return {"pose": {"trans": [G54["block"][0] - 100.0, G54["block"][1], TOP_Z], "rot": [0.0, 0.0, 0.0]},
+                "features": [{"type": "block", "size": [300, 150, 60]}]}
+    origin = [g + o for g, o in zip(G54["block"], part["origin"], strict=True)]
+    return {"pose": {"trans": origin, "rot": [0.0, 0.0, 0.0]},
+            "features": [{"type": "block", "size": list(part["size"])}, *part.get("features", [])]}
 
 
 class Machine:
@@ -85,6 +96,9 @@ class Machine:
 
     def ovi(self) -> list[int]:
         return self.ok(self.c.get("/api/nc/variables", params={"names": "_OVI"}))["_OVI"]
+
+    def offset(self, name: str = "G54") -> dict:
+        return self.ok(self.c.get(f"/api/offsets/{name}"))
 
     def wcs(self) -> dict:
         return self.ok(self.c.get("/api/machine"))["wcs"]

@@ -80,7 +80,7 @@ def test_ideal_lines_are_the_wave2_head_and_old_scenarios_load():
     plain = SimulatedMachine(load_scenario(head_scenario()))
     plain.goto({"A": 30.0, "B": 10.0})
     lines = plain.kinematic_data()
-    assert lines["A"] == {"point": [0.0, 0.0, 0.0], "direction": [1.0, 0.0, 0.0]}
+    assert lines["A"] == {"point": [0.0, 0.0, 0.0], "direction": [1.0, 0.0, 0.0], "unit": "head"}
     assert lines["B"]["direction"] == [0.0, 1.0, 0.0]
     st = plain.status()
     axes = np.array([st.mcs["X"], st.mcs["Y"], st.mcs["Z"]])
