@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import getpass
 import sys
+import threading
 from pathlib import Path
 
 from app.config import Settings
@@ -39,6 +40,9 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                         help="override the scenario's machine.time_scale (0 = no waiting)")
     parser.add_argument("--machine", choices=registry.names(), default=None,
                         help=f"the controller behind the HMI (default {registry.DEFAULT})")
+    parser.add_argument("--linuxcnc-ini", type=Path, default=None, metavar="PATH",
+                        help="with --machine linuxcnc (implied): the machine's own LinuxCNC INI, run headless or "
+                             "attached to when it runs already (design.md §10.7)")
     parser.add_argument("--trusted-host", action="append", default=None, metavar="NAME",
                         help="a Host name the HMI answers to besides the loopback names (repeatable)")
     parser.add_argument("--opcua", type=int, default=None, metavar="PORT",
@@ -80,8 +84,13 @@ def settings_from_args(args: argparse.Namespace) -> Settings:
     given = {"host": args.host, "port": args.port, "db_path": db_path, "db_url": db_url,
              "machine_name": getattr(args, "machine_name", None),
              "scenario_path": args.scenario, "time_scale": args.time_scale, "machine": args.machine,
+             "linuxcnc_ini": getattr(args, "linuxcnc_ini", None),
              "trusted_hosts": getattr(args, "trusted_host", None), "opcua_port": getattr(args, "opcua", None),
              "opcua_umati": getattr(args, "opcua_umati", None), "mtconnect_port": getattr(args, "mtconnect", None)}
+    if given["linuxcnc_ini"] is not None:
+        if args.machine not in (None, "linuxcnc"):
+            raise SystemExit(f"python -m app: --linuxcnc-ini runs LinuxCNC; it does not go with --machine {args.machine}")
+        given["machine"] = "linuxcnc"
     return Settings(**{k: v for k, v in given.items() if v is not None})
 
 
@@ -221,7 +230,39 @@ def main(argv: list[str] | None = None) -> None:
     if settings.host in ("0.0.0.0", "::"):
         print(f"python -m app: serving the network; browsers must use one of the trusted host names "
               f"{', '.join(trusted_hosts(settings))} (add the machine's name with --trusted-host)", file=sys.stderr)
-    uvicorn.run(app, host=settings.host, port=settings.port, log_level="info")
+    server = StoppingServer(uvicorn.Config(app, host=settings.host, port=settings.port, log_level="info"),
+                            stop_motion=app.state.services.machine.reset)
+    server.run()
+
+
+def _stopping_server_class():
+    import uvicorn
+
+    class _StoppingServer(uvicorn.Server):
+        """uvicorn's server that stops motion at SIGTERM/SIGINT (issue 34 §4): a graceful shutdown
+        waits for running requests, and a measurement's request would run to its end (48 s seen);
+        the channel's Reset (design.md §10.1) ends it within LinuxCNC's or the simulator's braking."""
+
+        def __init__(self, config, stop_motion) -> None:
+            super().__init__(config)
+            self._stop_motion = stop_motion
+
+        def handle_exit(self, sig, frame) -> None:
+            if not self.should_exit:
+                threading.Thread(target=self._reset, name="stop-motion", daemon=True).start()
+            super().handle_exit(sig, frame)
+
+        def _reset(self) -> None:
+            try:
+                self._stop_motion()
+            except Exception:   # noqa: BLE001 - the machine may refuse; the HMI stops anyway
+                pass
+
+    return _StoppingServer
+
+
+def StoppingServer(config, stop_motion):   # noqa: N802 - a class made when uvicorn is imported
+    return _stopping_server_class()(config, stop_motion)
 
 
 if __name__ == "__main__":

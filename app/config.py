@@ -23,6 +23,9 @@ class Settings(BaseSettings):
     scenario_path: Path | None = None          # None = the built-in demo scenario
     time_scale: float | None = Field(default=None, ge=0)  # overrides the scenario's machine.time_scale
     machine: str = "sim"                       # the controller, a name of app.machine.registry (design.md §9.6)
+    # design.md §10.7: the machine's own LinuxCNC INI (run headless, or attached to when it runs);
+    # None = the product's generated configuration with the simulated probe
+    linuxcnc_ini: Path | None = None
     # Host names the HMI answers to besides the loopback names (DNS rebinding guard, design.md §9.2);
     # HMI_TRUSTED_HOSTS='["hmi.plant.local", "10.0.0.5"]' or --trusted-host NAME (repeatable)
     trusted_hosts: list[str] = Field(default_factory=list)

@@ -63,13 +63,25 @@ ROOT = Path(__file__).resolve().parent.parent
 STATIC_DIR = ROOT / "static"
 
 
+def machine_options(settings: Settings) -> dict:
+    """The controller's own start-up options (design.md §10.7): LinuxCNC's configuration folder
+    follows ``--db``; ``--linuxcnc-ini`` runs the machine's own configuration."""
+    if settings.machine != "linuxcnc":
+        return {}
+    options: dict = {"db_path": None if settings.db_url else settings.db_path}
+    if settings.linuxcnc_ini is not None:
+        options["ini"] = settings.linuxcnc_ini
+    return options
+
+
 def build_services(settings: Settings, scenario: Scenario | LatheScenario) -> Services:
-    controller = build_machine(settings.machine, scenario)   # an unknown name fails before the db is touched
+    options = machine_options(settings)
+    controller = build_machine(settings.machine, scenario, options)   # an unknown name fails before the db is touched
     db = Database(settings.database, rotary_axes=tuple(a for a in scenario.axes if a not in "XYZ"),
                   machine=settings.machine_name)
     gud = SettingsService(db)
     machine = MachineService(db, controller, scenario, gud,
-                             rebuild=lambda other: build_machine(settings.machine, other))   # lathe <-> mill
+                             rebuild=lambda other: build_machine(settings.machine, other, options))   # lathe <-> mill
     services = Services(
         db=db, settings=gud, machine=machine,
         offsets=OffsetService(db, machine), tools=ToolService(db, machine),

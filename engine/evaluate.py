@@ -30,7 +30,7 @@ import numpy.typing as npt
 from engine import alarms
 from engine.compensation import trigger_radius
 from engine.correction import alpha_beta_from_normal
-from engine.fit import LineFit, fit_circle, fit_line, fit_plane, intersect_lines
+from engine.fit import CircleFit, LineFit, fit_circle, fit_line, fit_plane, intersect_lines
 from engine.planes import Plane, axis_index
 from engine.types import (
     CirclePoint,
@@ -136,6 +136,12 @@ def touch_radius(touch: Touch, probe: ProbeRecord | None, plane: Plane) -> float
 
 def circle_from_touches(touches: Sequence[Touch], plane: Plane, kind: str,
                         probe: ProbeRecord | None = None) -> tuple[FloatArray, float]:
+    centre, diameter, _fit = circle_fit_of_touches(touches, plane, kind, probe)
+    return centre, diameter
+
+
+def circle_fit_of_touches(touches: Sequence[Touch], plane: Plane, kind: str, probe: ProbeRecord | None = None
+                          ) -> tuple[FloatArray, float, CircleFit | None]:
     """(centre (3,), diameter) of a bore (``kind`` "hole") or shaft ("spigot").
 
     4 touches P1 +u, P2 −u, P3 +v, P4 −v (u ⟂ v, any probing angle; travel directions):
@@ -163,14 +169,14 @@ def circle_from_touches(touches: Sequence[Touch], plane: Plane, kind: str,
             diameter = chord if kind == "hole" else -chord   # shaft D = s4 − s3
             if diameter <= 0.0:
                 raise MeasuringError(alarms.CIRCLE_UNDETERMINED, f"{kind}: non-positive diameter {diameter:.6f}")
-            return _xyz(plane, centre_u * u + centre_v * v, height), float(diameter)
+            return _xyz(plane, centre_u * u + centre_v * v, height), float(diameter), None
     centres = np.array([_ao(plane, t.ball_centre) for t in touches])
     circle = fit_circle(centres)                        # CYCLE116 on the ball centres
     rho = float(np.mean([touch_radius(t, probe, plane) for t in touches]))
     radius = circle.radius + rho if kind == "hole" else circle.radius - rho   # jog-measuring §5.3 [I]
     if radius <= 0.0:
         raise MeasuringError(alarms.CIRCLE_UNDETERMINED, f"{kind}: non-positive radius {radius:.6f}")
-    return _xyz(plane, circle.center, height), 2.0 * radius
+    return _xyz(plane, circle.center, height), 2.0 * radius, circle
 
 
 def rect_from_touches(touches: Sequence[Touch], plane: Plane, kind: str
@@ -208,11 +214,30 @@ def rect_from_touches(touches: Sequence[Touch], plane: Plane, kind: str
 
 def _circle_of(point: StoredPoint, plane: Plane, kind: str, probe: ProbeRecord
                ) -> tuple[FloatArray, float]:
+    centre, diameter, _fit = _circle_fit_of(point, plane, kind, probe)
+    return centre, diameter
+
+
+def _circle_fit_of(point: StoredPoint, plane: Plane, kind: str, probe: ProbeRecord
+                   ) -> tuple[FloatArray, float, CircleFit | None]:
     if not isinstance(point, CirclePoint):
         raise ValueError(f"expected a CirclePoint, got {type(point).__name__}")
     if len(point.touches) >= 3:
-        return circle_from_touches(point.touches, plane, kind, probe)
-    return np.asarray(point.center, dtype=float), float(point.diameter)
+        return circle_fit_of_touches(point.touches, plane, kind, probe)
+    return np.asarray(point.center, dtype=float), float(point.diameter), None
+
+
+def _fit_values(fits: Sequence[CircleFit | None]) -> dict[str, Any]:
+    """``residuals`` and ``form_error`` of N-point circle fits (design.md §9.8, §10.2): one circle
+    its residuals (mm, + outside), several the worst form error of them; none: no keys."""
+    found = [f for f in fits if f is not None]
+    if not found:
+        return {}
+    if len(fits) == 1:
+        return {"residuals": [float(r) for r in found[0].residuals], "form_error": float(found[0].form_error),
+                "touches": int(found[0].n)}
+    return {"form_errors": [None if f is None else float(f.form_error) for f in fits],
+            "form_error": max(float(f.form_error) for f in found)}
 
 
 # --- edges ------------------------------------------------------------------------------------
@@ -383,19 +408,20 @@ def evaluate_circle1(task: str, params: dict[str, Any], points: Sequence[StoredP
     """1 hole / 1 circular spigot (jog-measuring §2.7.1, jog-measuring §2.8): centre P0 and diameter."""
     if len(points) != 1:
         raise ValueError(f"{task} needs 1 stored point, got {len(points)}")
-    centre, diameter = _circle_of(points[0], plane, kind, probe)
+    centre, diameter, fit = _circle_fit_of(points[0], plane, kind, probe)
     ao = _ao(plane, centre)
-    values = {"center": _plane_point(plane, ao), "diameter": diameter}
+    values = {"center": _plane_point(plane, ao), "diameter": diameter, **_fit_values([fit])}
     return TaskResult(task, values, FeatureFix(position=_plane_point(plane, ao), point=centre))
 
 
-def _centres(task: str, points: Sequence[StoredPoint], n: int, plane: Plane, probe: ProbeRecord, kind: str) -> tuple[list[FloatArray], list[float], float]:
+def _centres(task: str, points: Sequence[StoredPoint], n: int, plane: Plane, probe: ProbeRecord, kind: str
+             ) -> tuple[list[FloatArray], list[float], float, dict[str, Any]]:
     if len(points) != n:
         raise ValueError(f"{task} needs {n} stored points, got {len(points)}")
-    circles = [_circle_of(p, plane, kind, probe) for p in points]
-    centres = [_ao(plane, c) for c, _ in circles]
-    height = float(np.mean([plane.to_aop(c)[2] for c, _ in circles]))
-    return centres, [d for _, d in circles], height
+    circles = [_circle_fit_of(p, plane, kind, probe) for p in points]
+    centres = [_ao(plane, c) for c, _, _ in circles]
+    height = float(np.mean([plane.to_aop(c)[2] for c, _, _ in circles]))
+    return centres, [d for _, d, _ in circles], height, _fit_values([f for _, _, f in circles])
 
 
 def _directed_angle(a: FloatArray, b: FloatArray, what: str) -> float:
@@ -411,10 +437,10 @@ def evaluate_circles2(task: str, params: dict[str, Any], points: Sequence[Stored
     fix: the angle when an angle correction is asked (default "rotation"); with ``set_p1``
     and coordinate rotation also the translation of P1.
     """
-    (p1, p2), diameters, height = _centres(task, points, 2, plane, probe, kind)
+    (p1, p2), diameters, height, fits = _centres(task, points, 2, plane, probe, kind)
     alpha = _directed_angle(p1, p2, "P1→P2")                                   # jog-measuring §2.7.2
     values = {"angle": alpha, "p1": _plane_point(plane, p1), "p2": _plane_point(plane, p2),
-              "distance": float(np.linalg.norm(p2 - p1)), "diameters": diameters}
+              "distance": float(np.linalg.norm(p2 - p1)), "diameters": diameters, **fits}
     correction = params.get("angle_correction", "rotation")
     position = _plane_point(plane, p1) if params.get("set_p1") and correction == "rotation" else {}
     fix = FeatureFix(position=position, point=_xyz(plane, p1, height))
@@ -432,7 +458,7 @@ def evaluate_circles34(task: str, params: dict[str, Any], points: Sequence[Store
     4: P0 = intersection of the diagonals P1P3 and P2P4 (parallel -> 61368), alpha of P1→P2.
     fix: translation of P0; the angle only when ``angle_correction`` is not "none" (default).
     """
-    centres, diameters, height = _centres(task, points, n, plane, probe, kind)
+    centres, diameters, height, fits = _centres(task, points, n, plane, probe, kind)
     if n == 3:
         circle = fit_circle(np.array(centres))                                 # jog-measuring §6 circumcircle
         p0 = circle.center
@@ -448,7 +474,7 @@ def evaluate_circles34(task: str, params: dict[str, Any], points: Sequence[Store
     i, j = HOLE_ANGLE_LINE[n]
     alpha = _directed_angle(pts[i], pts[j], f"P{i}→P{j}")                     # jog-measuring §11 Q6
     values = {"center": _plane_point(plane, p0), "angle": alpha,
-              "points": [_plane_point(plane, c) for c in centres], "diameters": diameters, **extra}
+              "points": [_plane_point(plane, c) for c in centres], "diameters": diameters, **extra, **fits}
     p0_xyz = _xyz(plane, p0, height)
     fix = FeatureFix(position=_plane_point(plane, p0), point=p0_xyz)
     if _wants_angle(params, "none"):

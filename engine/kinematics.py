@@ -157,7 +157,8 @@ def _turn_sense(circle: CircleInSpace, points: FloatArray, angles: FloatArray) -
     total = 0.0
     for i in range(len(points)):
         for j in range(i + 1, len(points)):
-            total += float(np.cross(rel[i], rel[j]) @ circle.normal) * (angles[j] - angles[i])
+            # (r_i × r_j)·n = r²·sin(turn about n); the same sign as sin(θ_j − θ_i) when it turns +θ
+            total += float(np.cross(rel[i], rel[j]) @ circle.normal) * math.sin(math.radians(angles[j] - angles[i]))
     return 1.0 if total >= 0.0 else -1.0
 
 
@@ -170,6 +171,9 @@ def _angles_checked(angles: npt.ArrayLike, n: int) -> FloatArray:
     a = np.asarray(angles, dtype=float)
     if a.shape != (n,) or not np.all(np.isfinite(a)):
         raise ValueError(f"angles must be {n} finite numbers, got {angles!r}")
+    if n < MIN_POSITIONS:
+        raise MeasuringError(alarms.CIRCLE_PARAMETERS, f"a rotary axis needs {MIN_POSITIONS} or more positions, "
+                             f"got {n}")
     if len(set(np.round(a, 9))) < MIN_POSITIONS:
         raise MeasuringError(alarms.KINEMATICS_AXIS, f"{MIN_POSITIONS} or more different positions are needed")
     if float(a.max() - a.min()) < MIN_SPAN_DEG:
@@ -179,11 +183,15 @@ def _angles_checked(angles: npt.ArrayLike, n: int) -> FloatArray:
 
 
 def fit_axis(kind: str, centres: npt.ArrayLike, angles: npt.ArrayLike, probe_vector: npt.ArrayLike,
-             nominal: tuple[npt.ArrayLike, npt.ArrayLike]) -> AxisLine:
+             nominal: tuple[npt.ArrayLike, npt.ArrayLike], zero_centre: npt.ArrayLike | None = None) -> AxisLine:
     """One rotary axis from the sphere centres A_c(θ_i) (``centres``: X/Y/Z axis positions) at
     ``angles`` (deg). ``kind`` "head" or "table"; ``probe_vector`` v = ball centre − tool reference
     point at the zero position (skew − L·ẑ); ``nominal`` (point, direction) the control's data, for
-    orienting d and choosing the reported point. Minimum 3 positions spread over ≥ 10°."""
+    orienting d and choosing the reported point. Minimum 3 positions spread over ≥ 10°.
+
+    ``zero_centre``: A_c measured with every rotary axis at 0, so S = zero_centre + v exactly; needed
+    when another head axis was held off zero while this one turned (the circle's own zero position
+    is then not the machine's; ``probe_vector`` stays the zero-position v)."""
     pts = np.asarray(centres, dtype=float)
     a = _angles_checked(angles, len(pts))
     v = np.asarray(probe_vector, dtype=float)
@@ -202,7 +210,8 @@ def fit_axis(kind: str, centres: npt.ArrayLike, angles: npt.ArrayLike, probe_vec
     if kind == HEAD:
         # A_c(0): each centre turned back to the zero position about the fitted line, averaged
         at_zero = np.mean([circle.center + rotation_about(d, -t) @ r for t, r in zip(a, rel, strict=True)], axis=0)
-        point = at_zero + v - circle.center                   # p ≡ S − c, S = A_c(0) + v
+        sphere = (at_zero if zero_centre is None else np.asarray(zero_centre, dtype=float)) + v
+        point = sphere - circle.center                        # p ≡ S − c, S = A_c(0) + v
     else:
         point = circle.center
     return AxisLine(point=_line_near(point, d, nominal_point), direction=d, residual=circle.rms,

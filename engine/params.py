@@ -159,6 +159,40 @@ def validate_rect(spigot: bool) -> ParamsValidator:
     return validate
 
 
+MIN_CIRCLE_POINTS = 3       # a circle fit's minimum (engine.fit.fit_circle)
+MAX_CIRCLE_POINTS = 36
+
+
+def circle_touches(params: dict[str, Any]) -> dict[str, Any]:
+    """``points`` (touches per circle, evenly spaced from the probing angle) and/or ``angles`` (the
+    travel directions in degrees from the 1st plane axis), design.md §10.2. Absent: the 4-touch
+    programs of the manual (measuring-math §8.2)."""
+    out: dict[str, Any] = {}
+    n = params.get("points")
+    if n is not None:
+        n = int(n) if isinstance(n, str) and n.strip().isdigit() else n       # typed on a screen
+        if isinstance(n, bool) or not isinstance(n, int) or not MIN_CIRCLE_POINTS <= n <= MAX_CIRCLE_POINTS:
+            raise ParamError("points", f"points must be a whole number {MIN_CIRCLE_POINTS}..{MAX_CIRCLE_POINTS} "
+                             f"(touches on each circle), got {params['points']!r}")
+        out["points"] = n
+    angles = params.get("angles")
+    if angles is not None:
+        if not isinstance(angles, list) or not MIN_CIRCLE_POINTS <= len(angles) <= MAX_CIRCLE_POINTS or any(
+                isinstance(a, bool) or not isinstance(a, int | float) or not math.isfinite(a) for a in angles):
+            raise ParamError("angles", f"angles must be a list of {MIN_CIRCLE_POINTS}..{MAX_CIRCLE_POINTS} numbers "
+                             "(degrees)")
+        spread = sorted(float(a) % 360.0 for a in angles)
+        gaps = [b - a for a, b in zip(spread, [*spread[1:], spread[0] + 360.0], strict=True)]
+        if min(gaps) < 1.0 or max(gaps) >= 180.0:
+            raise ParamError("angles", "angles must differ by at least 1° and leave no gap of 180° or more "
+                             "(the circle would not be determined)")
+        if "points" in out and out["points"] != len(angles):
+            raise ParamError("points", f"points = {out['points']} but {len(angles)} angles are given")
+        out["angles"] = [float(a) for a in angles]
+        out["points"] = len(angles)
+    return out
+
+
 def validate_circles(spigot: bool) -> ParamsValidator:
     """1..4 holes (``spigot`` False) or circular spigots (jog-measuring §2.7, jog-measuring §2.8); ``variant`` = count."""
     def validate(variant: str, params: dict[str, Any], plane: Plane) -> dict[str, Any]:
@@ -176,6 +210,7 @@ def validate_circles(spigot: bool) -> ParamsValidator:
                 raise ParamError("set_p1", f"set_p1 must be true or false, got {set_p1!r}")
             out["set_p1"] = set_p1
         out["setpoint"] = _setpoint_point(params, plane)
+        out.update(circle_touches(params))
         return _passthrough_target(params, out)
     return validate
 
@@ -194,6 +229,10 @@ def validate_probe_radius(variant: str, params: dict[str, Any], plane: Plane) ->
     """Calibrate radius (jog-measuring §5.3): the ring gauge's diameter; optionally the number of probing
     directions per pass and the offset of off-centre chords (engine.plan_workpiece.ring_program)."""
     out: dict[str, Any] = {"diameter": _positive(params, "diameter", required=True)}
+    if params.get("points") not in (None, ""):            # design.md §10.2: the touches per pass
+        if params.get("directions") not in (None, "", params["points"]):
+            raise ParamError("points", "give points or directions, not both")
+        params = {**params, "directions": params["points"]}
     if params.get("directions") not in (None, ""):
         n = _number(params, "directions", required=True)     # given: never None
         if n != int(n) or not 4 <= n <= 36:

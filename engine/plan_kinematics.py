@@ -40,6 +40,7 @@ class KinematicsPoint:
     angle: float
     latched: FloatArray       # (k, 3) MCS axis positions at the triggers
     directions: FloatArray    # (k, 3) probing directions (MCS unit vectors)
+    reference: bool = False   # measured with every rotary axis at 0 (the sphere's own place)
 
 
 @dataclass(frozen=True)
@@ -59,6 +60,10 @@ class SphereProgram:
     position_feed: float
     table_line: tuple[FloatArray, FloatArray] | None = None
     ring: int = 12                       # touches per elevation
+    # another head axis held at an angle while ``axis`` turns (the outer axis of an A/C or B/C head
+    # turns about the tool axis at the zero position: the inner one tilts the probe off it)
+    partner: tuple[str, float] | None = None
+    reference: bool = False              # this point: every rotary axis at 0 (the sphere's place)
 
     def expected_centre(self) -> FloatArray:
         """Where the control expects the sphere at ``angle``: fixed for a head, turned by −θ about
@@ -86,8 +91,10 @@ def outward_directions(ring: int) -> list[FloatArray]:
     return out
 
 
-def _rotary(prog: SphereProgram, angle: float, label: str) -> RotaryStep:
-    return RotaryStep(tuple((a, float(angle) if a == prog.axis else 0.0) for a in prog.rotary_axes), label)
+def _rotary(prog: SphereProgram, angle: float, label: str, partner: bool = True) -> RotaryStep:
+    held = dict([prog.partner]) if prog.partner is not None and partner else {}
+    return RotaryStep(tuple((a, float(angle) if a == prog.axis else float(held.get(a, 0.0)))
+                            for a in prog.rotary_axes), label)
 
 
 def sphere_position_program(prog: SphereProgram, start: FloatArray, label: str
@@ -97,12 +104,15 @@ def sphere_position_program(prog: SphereProgram, start: FloatArray, label: str
         raise MeasuringError(alarms.SPHERE_DIAMETER, f"sphere diameter {prog.sphere_diameter:g}: must be > 0")
     rho_start = prog.sphere_diameter / 2.0 + prog.ball_radius + prog.clearance
     fixed = np.asarray(prog.sphere, dtype=float)
-    centre = prog.expected_centre()
+    centre = fixed if prog.reference else prog.expected_centre()
     safe_z = max(float(start[2]), float(fixed[2]) + 2.0 * rho_start, float(centre[2]) + 2.0 * rho_start)
     here = np.asarray(start, dtype=float)
     yield MoveStep(np.array([here[0], here[1], safe_z]), None, coords="MCS", label=f"{label} up")
     yield MoveStep(np.array([fixed[0], fixed[1], safe_z]), None, coords="MCS", label=f"{label} over the sphere")
-    yield _rotary(prog, prog.angle, f"{label} {prog.axis}={prog.angle:g}")
+    if prog.reference:
+        yield _rotary(prog, 0.0, f"{label} zero position", partner=False)
+    else:
+        yield _rotary(prog, prog.angle, f"{label} {prog.axis}={prog.angle:g}")
     hub = centre + np.array([0.0, 0.0, 2.0 * rho_start])
     yield MoveStep(np.array([hub[0], hub[1], max(hub[2], safe_z)]), None, coords="MCS", label=f"{label} across")
     yield MoveStep(hub, None, coords="MCS", label=f"{label} hub")
@@ -121,7 +131,7 @@ def sphere_position_program(prog: SphereProgram, start: FloatArray, label: str
         directions.append(-u)
         yield MoveStep(far, None, coords="MCS", label=f"{label} touch {k + 1} back")
         yield MoveStep(hub, None, coords="MCS", label=f"{label} hub")
-    back = _rotary(prog, 0.0, f"{label} back to the zero position")
+    back = _rotary(prog, 0.0, f"{label} back to the zero position", partner=False)
     yield RotaryStep(back.axes, back.label, tip=hub)          # the ball stays over the sphere
-
-    return KinematicsPoint(angle=float(prog.angle), latched=np.array(latched), directions=np.array(directions))
+    return KinematicsPoint(angle=0.0 if prog.reference else float(prog.angle), latched=np.array(latched),
+                           directions=np.array(directions), reference=prog.reference)

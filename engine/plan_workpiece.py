@@ -186,7 +186,7 @@ def _outer_chord_factory(dz: float) -> Chord:
 
 # --- evaluation of the stored point -------------------------------------------------------------
 
-def _touches(latches: Latches4, dirs: tuple[FloatArray, ...], ctx: PlanContext) -> tuple[Touch, ...]:
+def _touches(latches: tuple[HitLatch, ...], dirs: tuple[FloatArray, ...], ctx: PlanContext) -> tuple[Touch, ...]:
     return tuple(make_touch(lt.rec, d, ctx.probe, ctx.plane, skew_wcs=ctx.skew_wcs, spindle_angle=ctx.spindle_angle, wcs2bcs=ctx.wcs2bcs,
                             latched_mcs=lt.latched_mcs) for lt, d in zip(latches, dirs, strict=True))
 
@@ -216,9 +216,32 @@ def _circle_program(params: dict[str, Any], start: FloatArray, ctx: PlanContext,
     surf = _surface_of(ctx)
     _, found = yield from _pass(m, m.start + m.ball_offset, u1, u2, chord, (half, half),
                                 f"{label} pass 1", surf)
-    latches, _ = yield from _pass(m, found, u1, u2, chord, (half, half), f"{label} pass 2", surf)
+    given = circle_directions(params, ctx.plane)
+    latches: tuple[HitLatch, ...]
+    if given is None:
+        latches, _ = yield from _pass(m, found, u1, u2, chord, (half, half), f"{label} pass 2", surf)
+        dirs: tuple[FloatArray, ...] = (u1, -u1, u2, -u2)
+    else:           # N touches from the found centre, each along a diameter (design.md §10.2)
+        dirs, hits = tuple(given), []
+        for k, d in enumerate(dirs, start=1):
+            hits.append((yield from chord(m, found, d, half, f"{label} touch {k}")))
+        latches = tuple(hits)
     yield from m.back(m.start)
-    return circle_point(_touches(latches, (u1, -u1, u2, -u2), ctx), ctx, inner)
+    return circle_point(_touches(latches, dirs, ctx), ctx, inner)
+
+
+def circle_directions(params: dict[str, Any], plane: Plane) -> list[FloatArray] | None:
+    """The travel directions of ``params.points`` / ``params.angles`` (engine.params.circle_touches):
+    evenly spaced from the probing angle, or the given angles from the 1st plane axis; None: the
+    manual's ±1st, ±2nd pass."""
+    if "angles" in params:
+        thetas = [float(a) for a in params["angles"]]
+    elif "points" in params:
+        n = int(params["points"])
+        thetas = [float(params.get("probe_angle", 0.0)) + 360.0 * k / n for k in range(n)]
+    else:
+        return None
+    return [plane_directions(plane, theta)[0] for theta in thetas]
 
 
 def hole_program(params: dict[str, Any], start: FloatArray, ctx: PlanContext, label: str) -> Program[CirclePoint]:

@@ -97,6 +97,8 @@ class MachineStatus:
     #                                                           horizontal spindle: scenario machine.spindle_axis)
     probe: ProbeState | None = None          # the workpiece probe; None: the controller cannot tell
     tool_probe: ProbeState | None = None     # the tool probe; None: none, or the controller cannot tell
+    estop: bool = False                      # the controller's emergency stop is active (design.md §10.7)
+    machine_on: bool = True                  # the drives are on (LinuxCNC: task state ON)
     # where the control's head kinematics put the spindle nose relative to the X/Y/Z axis position
     # (MCS, mm; design.md §10.6): 0 for a head turning about the tool reference point, or no head
     head_shift: tuple[float, float, float] = (0.0, 0.0, 0.0)

@@ -63,6 +63,7 @@ def factory(name: str, kind: str = "mill"):
     return getattr(import_module(module), attribute)
 
 
-def build_machine(name: str, scenario: Scenario | LatheScenario) -> Machine:
-    """The machine registered as ``name``, built for ``scenario`` (its ``kind`` picks the table)."""
-    return factory(name, getattr(scenario, "kind", "mill"))(scenario)
+def build_machine(name: str, scenario: Scenario | LatheScenario, options: dict | None = None) -> Machine:
+    """The machine registered as ``name``, built for ``scenario`` (its ``kind`` picks the table);
+    ``options`` are the controller's own keyword arguments (LinuxCNC: ``ini``, ``db_path``)."""
+    return factory(name, getattr(scenario, "kind", "mill"))(scenario, **(options or {}))

@@ -115,6 +115,7 @@ class MachineService:
             active = unit.get_state(STATE_ACTIVE_OFFSET, G500)
             tool = unit.get_state(STATE_TOOL, None)
         self._seed_data(reset=False)
+        self._take_nc_tools()
         self._push_nc_data()
         self.activate(active if self._is_settable(active) else G500)
         self._restore_tool(tool)
@@ -184,6 +185,10 @@ class MachineService:
             "head_shift": [float(v) for v in head_shift_of(getattr(st, "head_shift", None))],
             "swivel": self.has_swivel(),
             "controller": self._machine.controller,
+            # design.md §10.7: the controller's E-stop and drives, and the machine's own INI (LinuxCNC)
+            "estop": bool(getattr(st, "estop", False)),
+            "machine_on": bool(getattr(st, "machine_on", True)),
+            "linuxcnc_ini": self._linuxcnc_ini(),
             **self._probe_status(st),
             **(self._lathe_status(st) if self.is_lathe else {}),
         }
@@ -226,6 +231,10 @@ class MachineService:
     def probe_status(self) -> dict:
         """``{"probe", "tool_probe"}`` of ``status()``, read alone (the probe test samples it)."""
         return self._probe_status(self._machine.status())
+
+    def _linuxcnc_ini(self) -> str | None:
+        own = getattr(self._machine, "own_ini", None)
+        return str(own) if own is not None else None
 
     def _probe_status(self, st: MachineStatus) -> dict:
         """``probe`` and ``tool_probe`` (design.md §10.4); a controller that cannot tell its
@@ -700,11 +709,37 @@ class MachineService:
         old.close()
 
     def _restore_tool(self, tool) -> None:
-        """Put the stored tool back into the spindle; the probe when none is stored or it is gone."""
+        """Put the stored tool back into the spindle; the probe when none is stored or it is gone.
+        A controller that refuses (a tool its own table lacks) keeps its spindle; its alarm shows."""
         try:
-            self.change_tool(tool if tool is not None else self._scenario.probe.t)
-        except NotFoundError:
-            self.change_tool(self._scenario.probe.t)
+            try:
+                self.change_tool(tool if tool is not None else self._scenario.probe.t)
+            except NotFoundError:
+                self.change_tool(self._scenario.probe.t)
+        except AlarmError:
+            pass                                   # posted by the machine (status().alarms)
+
+    def _take_nc_tools(self) -> None:
+        """A controller that owns its tool table (LinuxCNC with the machine's own INI,
+        ``nc_tool_table()``) gives its lengths and radii to the stored tools at the start; a tool
+        whose geometry + wear it holds already keeps the HMI's split."""
+        table = getattr(self._machine, "nc_tool_table", None)
+        held = table() if callable(table) else {}
+        if not held:
+            return
+        with self._db.unit() as unit:
+            for t, nc in held.items():
+                stored = unit.get_tool(t)
+                wear = (stored or {}).get("wear") or {}
+                if stored is not None \
+                        and abs(float(stored["length"]) + float(wear.get("length", 0.0)) - nc["length"]) < 1e-9 \
+                        and abs(float(stored["radius"]) + float(wear.get("radius", 0.0)) - nc["radius"]) < 1e-9:
+                    continue
+                kind = stored["type"] if stored is not None else (PROBE_TOOL_TYPE if t == self._scenario.probe.t
+                                                                  else 120)
+                unit.put_tool(t, {"type": kind, "length": nc["length"], "radius": nc["radius"],
+                                  "wear": {"length": 0.0, "radius": 0.0}}, source="controller",
+                              detail={"reason": "the controller's tool table"})
 
     def _seed_data(self, reset: bool) -> None:
         """Tool table from the scenario's nominal values (probe included) when empty or on reset;

@@ -7,6 +7,7 @@ from app.access.deps import guard
 from . import (
     docs,
     jog,
+    kinematics,
     log,
     machine_view,
     measure,
@@ -31,7 +32,7 @@ from . import (
 web_router = APIRouter(include_in_schema=False, dependencies=[Depends(guard)])   # app/access/deps.py
 for module in (panel, jog, offsets, tools, machine_view, settings, tilted_setup, measure, tool_probes,
                task_screens, log, setup_support, probes, plc, signin, docs, nc, memories, task_help, parts,
-               plant):
+               plant, kinematics):
     web_router.include_router(module.router)
 
 __all__ = ["web_router"]

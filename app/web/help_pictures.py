@@ -15,6 +15,8 @@ from html import escape
 from markupsafe import Markup
 
 from app.errors import InvalidInput, NotFoundError
+from app.i18n import N_, gettext
+from app.web import units
 from engine.plan_workpiece import corner_direction
 from engine.planes import Plane
 
@@ -61,7 +63,7 @@ class Picture:
                 'markerUnits="userSpaceOnUse" orient="auto-start-reverse"><path d="M0,0 L8,4 L0,8 z" class="help-head"/></marker></defs>')
         body = "".join(self.items)
         return Markup(f'<figure class="help-picture" data-task="{escape(task)}" data-touches="{self.touches}">'
-                      f'<svg class="help-svg" viewBox="0 0 {W} {H}" role="img" aria-label="help picture">'
+                      f'<svg class="help-svg" viewBox="0 0 {W} {H}" role="img" aria-label="{escape(gettext("help picture"))}">'
                       f'{defs}{body}{axes}</svg><figcaption>{escape(caption)}</figcaption></figure>')
 
 
@@ -210,7 +212,7 @@ def _rect(task: str, plane: Plane) -> Picture:
         pic.touch(f"{other}{plane.first}", 70, 75, -1, 0, plane.first, other)
         pic.touch(f"{sign}{plane.second}", 120, 45, 0, -1, plane.second, sign)
         pic.touch(f"{other}{plane.second}", 120, 105, 0, 1, plane.second, other)
-    pic.probe(120, 75, "start, above" if spigot else "start")
+    pic.probe(120, 75, gettext("start, above") if spigot else gettext("start"))
     pic.p0(120, 75)
     return pic
 
@@ -228,7 +230,8 @@ def _probe_length(plane: Plane) -> Picture:
     pic.add('<rect class="help-part" x="50" y="95" width="140" height="35"/>')
     pic.probe(120, 55, "probe")
     pic.touch(1, 120, 95, 0.0, 1.0, plane.infeed, "-")
-    pic.add(f'<text class="help-note" x="140" y="90">calibration height {plane.infeed}</text>')
+    note = gettext("calibration height %(axis)s", axis=plane.infeed)
+    pic.add(f'<text class="help-note" x="140" y="90">{escape(note)}</text>')
     return pic
 
 
@@ -239,7 +242,7 @@ def _probe_radius(plane: Plane) -> Picture:
                                (plane.second, 0, -1, 120, 35), (plane.second, 0, 1, 120, 115)):
         s = "+" if dx > 0 or dy < 0 else "-"
         pic.touch(f"{s}{axis}", x, y, dx, dy, axis, s)
-    pic.probe(120, 75, "ring centre")
+    pic.probe(120, 75, gettext("ring centre"))
     return pic
 
 
@@ -250,42 +253,45 @@ def _tool(task: str, plane: Plane) -> Picture:
             '<rect class="help-fixture" x="112" y="105" width="16" height="30"/>')
     if task == "tool.diameter":
         pic.add('<rect class="help-tool" x="60" y="30" width="20" height="70"/>'
-                '<text class="help-note" x="50" y="24">turning</text>')
+                '<text class="help-note" x="50" y="24">' + escape(gettext("turning")) + '</text>')
         pic.touch(1, 95, 100, 1.0, 0.0, plane.first, "+")
     else:
         pic.add('<rect class="help-tool" x="110" y="20" width="20" height="55"/>')
         pic.touch(1, 120, 95, 0.0, 1.0, plane.infeed, "-")
         if task == "toolprobe.calibrate":
-            pic.add('<text class="help-note" x="136" y="40">calibration tool</text>')
+            pic.add('<text class="help-note" x="136" y="40">' + escape(gettext("calibration tool")) + '</text>')
     return pic
 
 
 CAPTIONS = {
-    "edge.set": "Put the probe in front of the edge, at measuring depth; NC Start probes P1 in the direction shown.",
-    "edge.align": "In front of the edge: P1 first, then P2 further along the same edge; Calculate gives the angle.",
-    "edge.distance": "P1 in front of the first edge, P2 in front of the second; the centre between them is set.",
-    "corner.right": "At the corner, at measuring depth: P1 and P2 on the reference edge, P3 on the second edge.",
-    "corner.any": "P1 and P2 on the reference edge, P3 and P4 on the second edge; P0 is where the edges meet.",
-    "pocket.rect": "Probe roughly in the middle of the pocket, at measuring depth: four walls are probed.",
-    "spigot.rect": "Probe above the middle of the spigot: it goes round and probes the four sides at depth DZ.",
-    "plane.align": "Above the plane: P1, P2, P3 spread wide, each probed downwards; the plane's tilt is found.",
-    "probe.length": "The probe above a surface of known height (the calibration height); NC Start probes down.",
-    "probe.radius": "The probe in the calibration ring, roughly at its centre, at measuring depth.",
-    "toolprobe.calibrate": "The calibration tool above the tool probe's disc; NC Start probes the disc.",
-    "tool.length": "The tool above the tool probe's disc; NC Start probes down for the length.",
-    "tool.diameter": "The tool beside the disc, turning; NC Start probes sideways for the radius.",
+    "edge.set": N_("Put the probe in front of the edge, at measuring depth; NC Start probes P1 in the direction shown."),
+    "edge.align": N_("In front of the edge: P1 first, then P2 further along the same edge; Calculate gives the angle."),
+    "edge.distance": N_("P1 in front of the first edge, P2 in front of the second; the centre between them is set."),
+    "corner.right": N_("At the corner, at measuring depth: P1 and P2 on the reference edge, P3 on the second edge."),
+    "corner.any": N_("P1 and P2 on the reference edge, P3 and P4 on the second edge; P0 is where the edges meet."),
+    "pocket.rect": N_("Probe roughly in the middle of the pocket, at measuring depth: four walls are probed."),
+    "spigot.rect": N_("Probe above the middle of the spigot: it goes round and probes the four sides at depth DZ."),
+    "plane.align": N_("Above the plane: P1, P2, P3 spread wide, each probed downwards; the plane's tilt is found."),
+    "probe.length": N_("The probe above a surface of known height (the calibration height); NC Start probes down."),
+    "probe.radius": N_("The probe in the calibration ring, roughly at its centre, at measuring depth."),
+    "toolprobe.calibrate": N_("The calibration tool above the tool probe's disc; NC Start probes the disc."),
+    "tool.length": N_("The tool above the tool probe's disc; NC Start probes down for the length."),
+    "tool.diameter": N_("The tool beside the disc, turning; NC Start probes sideways for the radius."),
+    "hole.1": N_("Probe roughly at the centre of the hole, at measuring depth: NC Start probes the four points shown."),
+    "spigot.1": N_("Probe roughly at the centre of the spigot, above it: NC Start probes the four points shown."),
+}
+SEVERAL = {
+    "hole": N_("Probe at the centre of hole 1 (P1), NC Start; then hole 2 and on in order: each is a complete hole."),
+    "spigot": N_("Probe at the centre of spigot 1 (P1), NC Start; then spigot 2 and on in order: each is a complete "
+                 "spigot."),
 }
 
 
 def _caption(task: str) -> str:
+    """The picture's caption in the operator's language."""
     if task in CAPTIONS:
-        return CAPTIONS[task]
-    family, _, count = task.partition(".")
-    what = "hole" if family == "hole" else "spigot"
-    if count == "1":
-        return (f"Probe roughly at the centre of the {what}" + (", above it" if what == "spigot" else ", at measuring depth")
-                + ": NC Start probes the four points shown.")
-    return f"Probe at the centre of {what} 1 (P1), NC Start; then {what} 2 and on in order: each is a complete {what}."
+        return gettext(CAPTIONS[task])
+    return gettext(SEVERAL["hole" if task.startswith("hole") else "spigot"])
 
 
 def draw(task: str, params: dict | None, plane: Plane) -> Markup | None:
@@ -316,41 +322,61 @@ def draw(task: str, params: dict | None, plane: Plane) -> Markup | None:
 # --- the equipment a function uses (issue 17 item 5): shown beside its picture ----------------------
 
 def _yes(flag) -> str:
-    return "yes" if flag else "not yet"
+    return gettext("yes") if flag else gettext("not yet")
 
 
-def equipment_rows(services, task: str) -> list[tuple[str, str]]:
-    """(label, text) rows: the probe's calibration data, the calibration ring, the tool probe."""
+def _diameter(mm: float, gud) -> str:
+    """"Ø 4.000 mm" in the screen's unit and the language's decimal sign."""
+    return f"Ø {units.format_length(mm, gud)} {units.unit(gud)}"
+
+
+def _row(key: str, text: str) -> tuple[str, str, str]:
+    """(key for tests and styles, the label in the operator's language, the text)."""
+    return key, gettext(key), text
+
+
+def equipment_rows(services, task: str) -> list[tuple[str, str, str]]:
+    """(key, label, text) rows: the probe's calibration data, the calibration ring, the tool probe.
+    Labels are catalogue texts (N_), lengths in the screen's unit."""
     gud = services.settings.get()
-    rows: list[tuple[str, str]] = []
+    rows: list[tuple[str, str, str]] = []
     family = task.split(".")[0]
+    no_data = gettext("%(number)s: no data", number=gud.tool_probe_number if family in ("toolprobe", "tool")
+                      else gud.probe_number)
     if family in ("toolprobe", "tool"):
         try:
             tp = services.tool_probes.get(int(gud.tool_probe_number))
         except (NotFoundError, InvalidInput, ValueError, TypeError):    # no record, or no number set
-            return [("Tool probe", f"{gud.tool_probe_number}: no data")]
-        rows.append(("Tool probe", f"{tp['number']}, disc Ø {float(tp.get('disc_diameter') or 0):.3f} mm"))
-        rows.append(("Calibrated", f"length {_yes(tp.get('calibrated_length'))}, "
-                                   f"diameter {_yes(tp.get('calibrated_diameter'))}"))
+            return [_row(N_("Tool probe"), no_data)]
+        rows.append(_row(N_("Tool probe"), gettext("%(number)s, disc %(diameter)s", number=tp["number"],
+                                                   diameter=_diameter(float(tp.get("disc_diameter") or 0), gud))))
+        rows.append(_row(N_("Calibrated"), gettext("length %(length)s, diameter %(diameter)s",
+                                                   length=_yes(tp.get("calibrated_length")),
+                                                   diameter=_yes(tp.get("calibrated_diameter")))))
         if tp.get("calibration_tool"):
-            rows.append(("Calibration tool", f"T{tp['calibration_tool']}"))
+            rows.append(_row(N_("Calibration tool"), f"T{tp['calibration_tool']}"))
         return rows
     try:
         probe = services.probes.get(int(gud.probe_number))
     except (NotFoundError, InvalidInput, ValueError, TypeError):
-        return [("Probe data", f"{gud.probe_number}: no data")]
+        return [_row(N_("Probe data"), no_data)]
     effective = float(probe.get("effective_diameter") or 0.0)
-    ball = f"Ø {float(probe.get('ball_diameter') or 0):.3f} mm"
+    ball = _diameter(float(probe.get("ball_diameter") or 0), gud)
     if effective > 0:
-        ball += f", effective Ø {effective:.3f} mm"
-    rows.append(("Probe data", f"{probe['number']}: ball {ball}"))
-    rows.append(("Calibrated", f"radius {_yes(probe.get('calibrated_radius'))}, "
-                               f"length {_yes(probe.get('calibrated_length'))}"))
+        text = gettext("%(number)s: ball %(ball)s, effective %(effective)s", number=probe["number"], ball=ball,
+                       effective=_diameter(effective, gud))
+    else:
+        text = gettext("%(number)s: ball %(ball)s", number=probe["number"], ball=ball)
+    rows.append(_row(N_("Probe data"), text))
+    rows.append(_row(N_("Calibrated"), gettext("radius %(radius)s, length %(length)s",
+                                               radius=_yes(probe.get("calibrated_radius")),
+                                               length=_yes(probe.get("calibrated_length")))))
     if probe.get("cal_ring_diameter"):
-        rows.append(("Calibrated in ring", f"Ø {float(probe['cal_ring_diameter']):.3f} mm"))
+        rows.append(_row(N_("Calibrated in ring"), _diameter(float(probe["cal_ring_diameter"]), gud)))
     if task == "probe.radius":
         ring = float(gud.cal_ring_diameter or 0.0)
-        rows.append(("Calibration ring", f"Ø {ring:.3f} mm" if ring > 0 else "not set (type it in)"))
+        rows.append(_row(N_("Calibration ring"), _diameter(ring, gud) if ring > 0 else gettext("not set (type it in)")))
     if task == "probe.length":
-        rows.append(("Calibration height", f"{float(gud.cal_height or 0.0):.3f} mm"))
+        rows.append(_row(N_("Calibration height"),
+                         f"{units.format_length(float(gud.cal_height or 0.0), gud)} {units.unit(gud)}"))
     return rows

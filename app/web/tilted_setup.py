@@ -24,6 +24,7 @@ from fastapi import APIRouter, Form, Request
 from fastapi.responses import RedirectResponse
 
 from app.access.deps import needs
+from app.i18n import gettext
 from app.workflow import setup_support as support
 from engine.frames import Frame
 
@@ -107,10 +108,10 @@ def _render(request: Request, notice: str = ""):
 
 def _dialog(model: dict) -> str:
     if not model["target"]:
-        return "Select the zero offset to set up and press Start"
+        return gettext("Select the zero offset to set up and press Start")
     if model["complete"]:
-        return f"Set-up complete: {model['target']} holds the full 6-DOF zero offset"
-    return f"Next: step {model['current']}"
+        return gettext("Set-up complete: %(target)s holds the full 6-DOF zero offset", target=model["target"])
+    return gettext("Next: step %(step)s", step=model["current"])
 
 
 @router.get("/measure/workpiece/tilted-setup", name="tilted_setup_screen")

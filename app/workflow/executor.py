@@ -86,7 +86,7 @@ class StepExecutor:
             target = dict(step.axes)
             if step.tip is not None:          # to the zero position: tip = A − L·spindle axis
                 if any(abs(v) > 1e-12 for v in target.values()):
-                    raise ValueError("RotaryStep.tip: only with every rotary axis at 0")
+                    raise ValueError(f"RotaryStep.tip: only with every rotary axis at 0, got {target}")
                 axes = np.asarray(step.tip, dtype=float) + float(self.tool_length) * np.asarray(self.infeed_unit)
                 target.update({a: float(v) for a, v in zip(GEOMETRY_AXES, axes, strict=True)})
             result = self.machine.goto(target, None)

@@ -33,6 +33,7 @@ from engine.types import MeasuringError
 TASK = "kinematics.measure"
 MODES = {"check": "check", "optimise": "optimise", "optimize": "optimise"}
 MAX_POSITIONS = 36
+DEFAULT_PARTNER_DEG = 30.0
 ROTARY = ("A", "B", "C")
 
 
@@ -76,8 +77,30 @@ def validate(params: dict, plane: Plane) -> dict:
     clearance = _number(params.get("clearance", 5.0), "clearance")
     if not 0.5 <= clearance <= 50.0:
         raise ParamError("clearance", "clearance: 0.5 .. 50 mm")
-    return {"sphere": {"center": _centre(sphere.get("center")), "diameter": diameter}, "axis": axis,
-            "positions": angles, "mode": MODES[mode], "clearance": clearance}
+    out = {"sphere": {"center": _centre(sphere.get("center")), "diameter": diameter}, "axis": axis,
+           "positions": angles, "mode": MODES[mode], "clearance": clearance}
+    if "partner_angle" in params:
+        partner = _number(params["partner_angle"], "partner_angle")
+        if not -180.0 <= partner <= 180.0 or abs(partner) < 5.0:
+            raise ParamError("partner_angle", "partner_angle: 5° .. 180° (either sign): the inner head axis "
+                             "tilts the probe off the outer one")
+        out["partner_angle"] = partner
+    return out
+
+
+def partner_of(params: dict, facts: dict) -> tuple[str, float] | None:
+    """The inner head axis held at ``partner_angle`` (default 30°) while the outer one turns, when
+    the outer one's line runs along the tool axis at the zero position (C of an A/C or B/C head:
+    the ball would sit on it) or when ``partner_angle`` is given."""
+    lines = facts.get("lines", {})
+    head = sorted(a for a, line in lines.items() if line.get("unit", HEAD) == HEAD)
+    axis = params["axis"]
+    if len(head) != 2 or axis != head[1]:
+        return None
+    along_tool = abs(float(np.asarray(lines[axis]["direction"], dtype=float)[2])) > 0.9
+    if "partner_angle" not in params and not along_tool:
+        return None
+    return head[0], float(params.get("partner_angle", DEFAULT_PARTNER_DEG))
 
 
 def _machine_facts(ctx: MeasuringContext) -> dict:
@@ -112,8 +135,10 @@ def _program(params: dict, n: int, start, ctx: MeasuringContext, label: str):
     kind = line.get("unit", HEAD)
     probe = ctx.probe
     rho = effective_radius(probe) if probe is not None else 0.0
+    reference = n > len(params["positions"])
     prog = SphereProgram(
-        axis=axis, kind=kind, angle=float(params["positions"][n - 1]), rotary_axes=tuple(facts["rotary_axes"]),
+        axis=axis, kind=kind, angle=0.0 if reference else float(params["positions"][n - 1]),
+        rotary_axes=tuple(facts["rotary_axes"]), partner=partner_of(params, facts), reference=reference,
         sphere=np.asarray(params["sphere"]["center"], dtype=float), sphere_diameter=float(params["sphere"]["diameter"]),
         ball_radius=rho, clearance=float(params["clearance"]),
         measuring_feed=float(ctx.settings.measuring_feed), position_feed=float(ctx.settings.position_feed),
@@ -128,20 +153,24 @@ def finish_kinematics(session, ctx: MeasuringContext, points: list) -> tuple[dic
     facts = _machine_facts(ctx)
     probe = ctx.probe
     rho = effective_radius(probe) if probe is not None else 0.0
-    spheres = [sphere_at_position(p.angle, p.latched, rho) for p in points]
+    measured = [sphere_at_position(p.angle, p.latched, rho) for p in points]
     nominal_d = float(params["sphere"]["diameter"])
-    check_sphere_diameter(spheres, nominal_d, float(ctx.settings.kinematics_sphere_tolerance))
+    check_sphere_diameter(measured, nominal_d, float(ctx.settings.kinematics_sphere_tolerance))
+    zero = [s for s, p in zip(measured, points, strict=True) if getattr(p, "reference", False)]
+    spheres = [s for s, p in zip(measured, points, strict=True) if not getattr(p, "reference", False)]
     line = facts["lines"][axis]
     nominal = _line(facts, axis)
     kind = line.get("unit", HEAD)
+    partner = partner_of(params, facts)
     fitted = fit_axis(kind, [s.axes_centre for s in spheres], [s.angle for s in spheres], _probe_vector(ctx),
-                      nominal)
+                      nominal, zero_centre=zero[0].axes_centre if zero else None)
     deviation = line_deviation(fitted, nominal)
     result = {
         "axes": {axis: fitted.to_api()},
         "deviation": {axis: deviation},
         "nominal": {axis: {"point": [float(v) for v in nominal[0]], "direction": [float(v) for v in nominal[1]]}},
-        "sphere_diameter": float(np.mean([s.diameter for s in spheres])),
+        "sphere_diameter": float(np.mean([s.diameter for s in measured])),
+        "partner": None if partner is None else {partner[0]: partner[1]},
         "spheres": [{"angle": s.angle, "axes_center": [float(v) for v in s.axes_centre], "diameter": s.diameter,
                      "rms": s.rms, "touches": s.n} for s in spheres],
         "unit": kind, "mode": params["mode"], "written": False,
@@ -173,6 +202,12 @@ def check_machine(params: dict, facts: dict) -> None:
     if outside:
         raise ParamError("positions", f"positions: {', '.join(f'{a:g}' for a in outside)} outside the limits "
                          f"of {axis} [{lo:g}, {hi:g}]")
+    partner = partner_of(params, facts)
+    if partner is not None:
+        p_lo, p_hi = facts.get("limits", {}).get(partner[0], (-math.inf, math.inf))
+        if not p_lo <= partner[1] <= p_hi:
+            raise ParamError("partner_angle", f"partner_angle: {partner[1]:g}° is outside the limits of "
+                             f"{partner[0]} [{p_lo:g}, {p_hi:g}]")
 
 
 def program(params: dict, n: int, start, ctx: MeasuringContext, label: str):

@@ -63,6 +63,7 @@ class TaskSpec:
     validator: Callable[[dict, Plane], dict] | None = None   # None: the engine's
     planner: Callable | None = None                          # None: the engine's program
     max_points: int = 0          # > 0: ``params.points`` may add points up to this (a fitted line/plane)
+    circle_points: bool = False  # ``params.points`` = touches on each fitted circle (engine.params.circle_touches)
 
     # --- what the engine knows -----------------------------------------------------------
     @property
@@ -86,8 +87,9 @@ class TaskSpec:
         return self.engine.points == 1
 
     def points_of(self, params: dict) -> int:
-        """P1..Pn of a session: the task's own count, or ``params.points`` (design.md §9.8)."""
-        return int(params.get("points", self.points))
+        """P1..Pn of a session: the task's own count, or ``params.points`` (design.md §9.8); a
+        circle task keeps its P count (its points are the touches on each circle, §10.2)."""
+        return self.points if self.circle_points else int(params.get("points", self.points))
 
     @property
     def coords(self) -> str:
@@ -116,7 +118,7 @@ class TaskSpec:
         and, for a tool offset, ``tolerance`` (design.md §9.3)."""
         params = dict(params or {})
         out = (self.validator or self.engine.validate)(params, plane)
-        if "points" in params:
+        if "points" in params and not self.circle_points:      # circle tasks: the engine's validator
             n = params["points"]
             n = int(n) if isinstance(n, str) and n.strip().isdigit() else n      # typed on a screen
             if not self.max_points:
@@ -288,7 +290,9 @@ def _spec(name: str, category: Category, targets: frozenset[Target], finisher: F
 
 def _workpiece(name: str, form, targets: frozenset[Target] = _ZO, max_points: int = 0) -> TaskSpec:
     finisher = finish_workpiece_or_tool if Target.TOOL_OFFSET in targets else finish.finish_workpiece
-    return dataclasses.replace(_spec(name, Category.WORKPIECE, targets, finisher, form), max_points=max_points)
+    circles = name.startswith(("hole.", "spigot.")) and name != "spigot.rect"
+    return dataclasses.replace(_spec(name, Category.WORKPIECE, targets, finisher, form), max_points=max_points,
+                               circle_points=circles)
 
 
 TASKS: dict[str, TaskSpec] = {spec.name: spec for spec in [
@@ -306,8 +310,8 @@ TASKS: dict[str, TaskSpec] = {spec.name: spec for spec in [
     _workpiece("plane.align", forms.plane_form, max_points=MAX_FIT_POINTS),
     _spec("probe.length", Category.PROBE_CALIBRATION, frozenset({Target.PROBE_RECORD, Target.TOOL_DATA}),
           finish_probe.finish_probe_length, forms.probe_length_form),
-    _spec("probe.radius", Category.PROBE_CALIBRATION, frozenset({Target.PROBE_RECORD}),
-          finish_probe.finish_probe_radius, forms.probe_radius_form),
+    dataclasses.replace(_spec("probe.radius", Category.PROBE_CALIBRATION, frozenset({Target.PROBE_RECORD}),
+                              finish_probe.finish_probe_radius, forms.probe_radius_form), circle_points=True),
     _spec("toolprobe.calibrate", Category.TOOL_PROBE_CALIBRATION, frozenset({Target.TOOL_PROBE_RECORD}),
           finish_tool.finish_toolprobe_calibrate, forms.toolprobe_form,
           planner=_first_toolprobe_search_longer),
@@ -356,7 +360,7 @@ class KinematicsTaskSpec(TaskSpec):
     guarded = False
 
     def points_of(self, params: dict) -> int:
-        return len(params["positions"])
+        return len(params["positions"]) + (1 if "_reference" in params else 0)
 
     def coords_for(self, params: dict, plan_ctx) -> str:
         return "MCS"
@@ -373,7 +377,10 @@ class KinematicsTaskSpec(TaskSpec):
         return 1
 
     def check_machine(self, params: dict, env) -> None:
-        kinematics_task.check_machine(params, env.measuring_context().extra.get("kinematics") or {})
+        facts = env.measuring_context().extra.get("kinematics") or {}
+        kinematics_task.check_machine(params, facts)
+        if kinematics_task.partner_of(params, facts) is not None:
+            params["_reference"] = True        # P(n+1): the sphere with every rotary axis at 0
 
 
 KINEMATICS_SPEC = KinematicsTaskSpec(kinematics_task.ENGINE_TASK, Category.WORKPIECE, frozenset(),

@@ -128,3 +128,32 @@ def test_bad_params_are_400_naming_the_field(tmp_path, params, field):
         r = client.post("/api/measure", json=body)
         assert r.status_code == 400, r.text
         assert r.json()["error"]["field"] == field
+
+
+TRUE_FORK = {"B": {"point": [0.030, 0.0, -0.020], "direction": [20e-6, 1.0, -35e-6]},
+             "C": {"point": [-0.025, 0.040, 0.0], "direction": [30e-6, -20e-6, 1.0]}}
+
+
+def test_fork_head_c_axis_measured_with_b_tilted(tmp_path):
+    """B/C head: C runs along the tool axis at the zero position, so B is held at 30° while C turns
+    and the sphere is measured once more with both at 0 (its own place). Checked: B first (C at 0),
+    then C, each against the truth; the points count shows the reference point."""
+    sc = kin_scenario(true=TRUE_FORK)
+    sc["rotary_axes"] = {"B": {"limits": [-60.0, 60.0]}, "C": {"limits": [-360.0, 360.0]}}
+    sc["machine"]["kinematics"] = {"type": "swivel_head", "axes": ["B", "C"], "true": TRUE_FORK}
+    with make_client(tmp_path, sc) as client:
+        for axis, positions in (("B", [-60.0, -30.0, 0.0, 30.0, 60.0]), ("C", [-120.0, -60.0, 0.0, 60.0, 120.0])):
+            session = post(client, "/api/measure", {"task": "kinematics.measure", "params": {
+                "sphere": {"center": [float(v) for v in sphere_mcs(sc)], "diameter": SPHERE_D},
+                "axis": axis, "positions": positions, "mode": "optimise"}})
+            assert len(session["points"]) == len(positions) + (1 if axis == "C" else 0)
+            for _ in session["points"]:
+                post(client, f"/api/measure/{session['id']}/start")
+            result = post(client, f"/api/measure/{session['id']}/calculate")["result"]
+            distance, angle = line_errors(result["axes"][axis], TRUE_FORK[axis])
+            print(f"fork {axis}: line {distance * 1000:.3f} um, direction {angle * 1e6:.2f} urad, "
+                  f"partner {result['partner']}")
+            assert distance < 0.002 and angle < 10e-6
+            assert (result["partner"] == {"B": 30.0}) == (axis == "C")
+        status = client.get("/api/machine").json()
+        assert status["mcs"]["B"] == 0.0 and status["mcs"]["C"] == 0.0      # back at the zero position

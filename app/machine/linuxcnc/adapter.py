@@ -73,8 +73,11 @@ from ..protocol import (
 )
 from ..scenario import GEOMETRY_AXES, Scenario
 from ..scene import protection_data
-from .config import COMPONENT, TOOL_TABLE, scenario_tools, tool_table_text
+from . import process as process_module
+from .config import COMPONENT, TOOL_TABLE, scenario_tools, tool_table_text, write_config
 from .modules import LinuxCncMissing, import_linuxcnc
+from .own import OwnIni
+from .own_probe import OwnProbing
 from .process import LinuxCncProcess, LinuxCncStartError
 
 G5X = {"G54": 1, "G55": 2, "G56": 3, "G57": 4, "G58": 5, "G59": 6, "G59.1": 7, "G59.2": 8, "G59.3": 9}
@@ -84,15 +87,20 @@ BEGIN_S = 3.0          # how long a block that moves may take to be seen moving
 POLL_S = 0.002
 MIN_TRAVEL = 0.01       # mm: a shorter block may round to no motion at all in LinuxCNC's words
 CONNECT_TIMEOUT_S = 10.0
+HOMING_S = 60.0
 PROBE_TYPE = 710
 
 
-def data_folder() -> Path:
-    """Where the configuration goes: ``HMI_LINUXCNC_DIR``, else ``linuxcnc/`` next to the db."""
+def data_folder(db_path: Path | str | None = None) -> Path:
+    """Where the configuration goes: ``HMI_LINUXCNC_DIR``, else ``linuxcnc/`` next to the db
+    (``--db``; a database URL: next to the default one)."""
     given = os.environ.get("HMI_LINUXCNC_DIR")
     if given:
         return Path(given)
-    return Path(os.environ.get("HMI_DB_PATH", "data/hmi.db")).resolve().parent / "linuxcnc"
+    db = str(db_path) if db_path is not None else os.environ.get("HMI_DB_PATH", "data/hmi.db")
+    if "://" in db:
+        db = "data/hmi.db"
+    return Path(db).resolve().parent / "linuxcnc"
 
 
 def _num(value: float) -> str:
@@ -102,9 +110,14 @@ def _num(value: float) -> str:
 
 
 class LinuxCncMachine:
-    """A 3-axis mill on LinuxCNC with the touch probe fed from the scenario's scene."""
+    """A 3-axis mill on LinuxCNC: the generated configuration with the touch probe fed from the
+    scenario's scene, or (``ini``) the machine's own configuration and probe (own.py, own_probe.py)."""
 
-    def __init__(self, scenario: Scenario, folder: Path | None = None) -> None:
+    def __init__(self, scenario: Scenario, folder: Path | None = None, ini: Path | str | None = None,
+                 db_path: Path | str | None = None) -> None:
+        self._own: OwnIni | None = OwnIni(Path(ini)) if ini is not None else None
+        if self._own is not None:
+            scenario = self._own.scenario(scenario)
         if tuple(scenario.axes) != GEOMETRY_AXES or scenario.machine.kinematics is not None:
             raise LinuxCncStartError("the LinuxCNC configuration has the axes X, Y, Z only; the scenario has "
                                      f"{', '.join(scenario.axes)}" + (" and a swivel head" if scenario.machine.kinematics
@@ -137,15 +150,48 @@ class LinuxCncMachine:
         self._seq = 0
         self._closed = False
         self.last_probe: dict | None = None
+        self._probing = OwnProbing(self) if self._own is not None else None
+        self.attached = False
         t0 = time.monotonic()
-        self._process = LinuxCncProcess(scenario, folder or data_folder())
-        self._process.start()
+        folder = Path(folder) if folder is not None else data_folder(db_path)
+        if self._own is None:
+            self._process = LinuxCncProcess(folder, lambda where: write_config(scenario, where))
+        else:
+            own = self._own
+            self._process = LinuxCncProcess(folder, lambda _where: own.headless_copy(), component=False)
+            self.attached = self._running_with(own)
+        if not self.attached:
+            self._process.start()
         try:
             self._connect()
         except BaseException:
             self._process.stop()
             raise
         self.startup_s = time.monotonic() - t0
+
+    def _running_with(self, own: OwnIni) -> bool:
+        """A LinuxCNC already runs the machine's INI (its own display, or a headless copy): attach.
+        A stale instance this HMI started (its HMI gone) is not attached to: the start replaces it."""
+        running_processes = process_module.running()
+        if not process_module.LOCK_FILE.exists() or not running_processes \
+                or process_module.stale_instance(running_processes) is not None:
+            return False
+        try:
+            s = self._lc.stat()
+            s.poll()
+        except self._lc.error:
+            return False
+        running = Path(str(s.ini_filename or ""))
+        if not running.name:
+            return False
+        if running.parent.resolve() != own.path.parent or running.name not in (own.path.name, own.headless_copy().name):
+            raise LinuxCncStartError(f"a LinuxCNC with another configuration is running ({running}); stop it first")
+        return True
+
+    @property
+    def own_ini(self) -> Path | None:
+        """The machine's own INI file (``--linuxcnc-ini``), None on the generated configuration."""
+        return None if self._own is None else self._own.path
 
     # --- connection -----------------------------------------------------------------------
     def _connect(self) -> None:
@@ -161,15 +207,24 @@ class LinuxCncMachine:
                 raise LinuxCncStartError("LinuxCNC's task does not answer")
             time.sleep(0.01)
             s = self._stat()
-        self._set_pin("latency", float(self._scenario.machine.latency_s))
+        if self._own is None:
+            self._set_pin("latency", float(self._scenario.machine.latency_s))
+        else:
+            deadline += HOMING_S                # the machine's own homing moves the axes
         self._ensure_on()
         while not all(self._stat().homed[:3]):
             if time.monotonic() > deadline:
                 raise LinuxCncStartError("LinuxCNC did not home")
             time.sleep(0.005)
         self._mdi("G21 G17 G90 G94 G40 G92.1")
-        self._mdi(f"T{self._tool} M6")
-        self._mdi(f"G43.1 Z{_num(self._offset_length)}")
+        if self._own is None:
+            self._mdi(f"T{self._tool} M6")
+            self._mdi(f"G43.1 Z{_num(self._offset_length)}")
+        else:                                   # the machine's tools: the table and the spindle as LinuxCNC has them
+            s = self._stat()
+            self._tools = self._own_tools(s)
+            self._tool = int(s.tool_in_spindle) or None
+            self._offset_length = float(s.tool_offset[2])
         self._drain()
         self._messages.clear()
 
@@ -228,16 +283,21 @@ class LinuxCncMachine:
         """The truth the probe input is fed from (tests only; the HMI never sees it)."""
         return self._contact.scene
 
-    def protection_model(self) -> dict:
+    def protection_model(self) -> dict | None:
         """The start guard's model (issue 24 §1), as the simulator's: the generated configuration
         is commissioned from the scenario, so its scene and limits are this control's protection
-        zones (plain data, MCS)."""
+        zones (plain data, MCS). The machine's own configuration has none (None): the guard says
+        so in the plan and the warnings."""
+        if self._own is not None:
+            return None
         limits = {a: [float(lo), float(hi)] for a, (lo, hi) in self._kin.limits.items()}
         return {"bodies": protection_data(self._contact.scene), "limits": limits}
 
     def _position(self) -> np.ndarray:
         """The joint positions as the servo thread has them now (the comparator's own inputs):
         never a task cycle late, unlike ``stat.actual_position``."""
+        if self._own is not None:
+            return np.array([self._hal.get_value(f"joint.{j}.pos-fb") for j in range(3)], dtype=float)
         return np.array([self._pin("pos-x"), self._pin("pos-y"), self._pin("pos-z")], dtype=float)
 
     def status(self) -> MachineStatus:
@@ -246,12 +306,14 @@ class LinuxCncMachine:
                 raise self._lc.error("LinuxCNC was stopped")
             s = self._stat()
             position = np.array(s.actual_position[:3], dtype=float)
+            estop, machine_on = s.task_state == self._lc.STATE_ESTOP, s.task_state == self._lc.STATE_ON
             spindle = s.spindle[0]
             speed = float(spindle["speed"]) * (1.0 if spindle["direction"] >= 0 else -1.0) \
                 if spindle["enabled"] else 0.0
         except self._lc.error as exc:
             position = getattr(self, "_last_position", np.zeros(3))
             speed = 0.0
+            estop, machine_on = False, False
             if not self._closed:
                 self._raise(Alarm.of(alarms.CONTROLLER_ERROR, f"LinuxCNC does not answer: {exc}"))
         self._last_position = position
@@ -263,7 +325,8 @@ class LinuxCncMachine:
                 mcs=self._kin.as_dict(position), wcs={a: float(p_wcs[i]) for i, a in enumerate(GEOMETRY_AXES)},
                 active_offset=self._frame.name, tool=self._tool, tool_length=float(length),
                 feed_override=float(self._override), spindle_angle=float(self._spindle_angle),
-                spindle_speed=float(speed) if speed else 0.0, busy=self._busy, alarms=self._alarms.shown())
+                spindle_speed=float(speed) if speed else 0.0, busy=self._busy, alarms=self._alarms.shown(),
+                estop=bool(estop), machine_on=bool(machine_on))
 
     def post_alarm(self, alarm: Alarm) -> None:
         self._raise(alarm)
@@ -425,7 +488,11 @@ class LinuxCncMachine:
             raise MachineAlarm(self._raise(self._controller_alarm(errors)))
 
     def _arm(self, start: np.ndarray, d: np.ndarray, s_switch: float | None) -> int:
-        """Arm the comparator for the straight path start + s·d; returns the arming's seq."""
+        """Arm the comparator for the straight path start + s·d; returns the arming's seq.
+        The machine's own probe needs no arming (its switch in a non-probe move is LinuxCNC's error)."""
+        if self._own is not None:
+            self._seq += 1
+            return self._seq
         for axis, p0, di in zip("xyz", start, d, strict=True):
             self._set_pin(f"p0-{axis}", float(p0))
             self._set_pin(f"d-{axis}", float(di))
@@ -441,17 +508,23 @@ class LinuxCncMachine:
         return self._seq
 
     def _tripped(self, seq: int) -> bool:
+        if self._own is not None:
+            return False
         return self._pin("latched-seq") == seq
 
     def _latch(self) -> np.ndarray:
         return np.array([self._pin("latch-x"), self._pin("latch-y"), self._pin("latch-z")], dtype=float)
 
     def _event(self, start: np.ndarray, d: np.ndarray, length: float) -> Event | None:
+        if self._own is not None:
+            return None                         # the machine's own probe: no scene known
         with self._lock:
             tool, angle = self._tool, self._spindle_angle
         return self._contact.first_event(start, d, length, tool, angle)
 
     def _is_probe(self) -> bool:
+        if self._own is not None:
+            return self._tool is not None and self._tool == self._scenario.probe.t
         return self._contact.is_probe(self._tool)
 
     def _check_limits(self, target: np.ndarray) -> None:
@@ -628,13 +701,20 @@ class LinuxCncMachine:
         self._alarms.reset()
 
     def probe(self, direction, distance: float, feed: float) -> ProbeResult:
-        """G38.3 along ``direction``; the result is the comparator's latch."""
+        """G38.3 along ``direction``; the result is the comparator's latch (the generated
+        configuration) or LinuxCNC's own probed position, two-stage (own_probe.py)."""
         d = np.asarray(direction, dtype=float).reshape(-1)
         if d.shape != (3,) or not np.all(np.isfinite(d)) or not np.linalg.norm(d) > 0.0:
             raise ValueError("direction must be a finite, non-zero [dx, dy, dz]")
         d = d / np.linalg.norm(d)
         distance = positive(distance, "distance")
         feed = positive(feed, "feed")
+        if self._probing is not None:
+            self._begin()
+            try:
+                return self._probing.probe(d, distance, feed)
+            finally:
+                self._finish()
         self._begin()
         try:
             start = self._position()
@@ -705,7 +785,11 @@ class LinuxCncMachine:
 
     def change_tool(self, tool: int | None, offset_length: float) -> None:
         offset_length = finite(offset_length, "offset_length")
-        if tool is not None and tool != self._scenario.probe.t and self._scenario.tool(tool) is None:
+        if self._own is not None:
+            if tool is not None and tool not in self._tools:
+                raise MachineAlarm(self._raise(Alarm.of(alarms.NO_TOOL_FOR_IDENTIFIER, f"No tool for the given tool "
+                                                        f"identifier: T{tool} is not in LinuxCNC's tool table")))
+        elif tool is not None and tool != self._scenario.probe.t and self._scenario.tool(tool) is None:
             raise MachineAlarm(self._raise(Alarm.of(alarms.NO_TOOL_FOR_IDENTIFIER, f"No tool for the given tool "
                                                     f"identifier: T{tool} is not in the magazine")))
 
@@ -730,8 +814,43 @@ class LinuxCncMachine:
 
     def write_tool(self, t: int, data: dict) -> None:
         self._nc.write_tool(t, data)                  # ValueError naming the field
+        if self._own is not None:
+            self._write_own_tool(t, self._nc.tools[t])
+            return
         self._tools[t] = self._nc.tools[t]
         self._quiet(self._load_tool_table)
+
+    # --- the machine's own tool table (LinuxCNC owns it: G10 L1, never the file) ------------------
+    @staticmethod
+    def _own_tools(s) -> dict[int, dict]:
+        tools = {}
+        for entry in s.tool_table:
+            t = int(entry.id)
+            if t > 0:
+                tools[t] = {"type": 120, "length": float(entry.zoffset), "radius": float(entry.diameter) / 2.0,
+                            "wear": {"length": 0.0, "radius": 0.0}}
+        return tools
+
+    def nc_tool_table(self) -> dict[int, dict]:
+        """The machine's own tool table (``--linuxcnc-ini``): {T: {"length", "radius"}} as LinuxCNC
+        holds it (the HMI takes it over at its start); {} on the generated configuration."""
+        if self._own is None:
+            return {}
+        return {t: {"length": d["length"], "radius": d["radius"]} for t, d in self._tools.items()}
+
+    def _write_own_tool(self, t: int, data: dict) -> None:
+        """A tool LinuxCNC has gets the HMI's length and radius (geometry + wear) by ``G10 L1``; a tool
+        it does not have stays the HMI's (LinuxCNC's table is the machine owner's)."""
+        if t not in self._tools:
+            return
+        wear = data.get("wear") or {}
+        length = float(data["length"]) + float(wear.get("length", 0.0))
+        radius = float(data["radius"]) + float(wear.get("radius", 0.0))
+        held = self._tools[t]
+        if held["length"] == length and held["radius"] == radius:
+            return
+        self._quiet(lambda: self._setup(f"G10 L1 P{t} Z{_num(length)} R{_num(radius)}"))
+        self._tools[t] = {**held, "length": length, "radius": radius}
 
     def _load_tool_table(self) -> None:
         (self._process.folder / TOOL_TABLE).write_text(tool_table_text(self._tools), encoding="utf-8")
@@ -836,6 +955,9 @@ class LinuxCncMachine:
         """LinuxCNC's tool data of T ``t``: {"length": Z, "diameter": D}, from the tool table file
         its io has loaded (``stat.tool_table`` comes through a memory map that the python module
         opens once per process: stale after a LinuxCNC restart in the same process)."""
+        if self._own is not None:
+            held = self._tools[t]
+            return {"length": held["length"], "diameter": 2.0 * held["radius"]}
         text = (self._process.folder / TOOL_TABLE).read_text(encoding="utf-8")
         for line in text.splitlines():
             words = dict((w[0], w[1:]) for w in line.split(";", 1)[0].split())
@@ -867,4 +989,5 @@ class LinuxCncMachine:
             self._halcomp.exit()
         except Exception:   # noqa: BLE001
             pass
-        self._process.stop()
+        if not self.attached:                  # a LinuxCNC the HMI attached to runs on
+            self._process.stop()
