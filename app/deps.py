@@ -28,7 +28,8 @@ from app.services.probe_test import ProbeTestService
 from app.workflow.service import WorkflowService
 
 
-def get_services(request: Request) -> Services:
+async def get_services(request: Request) -> Services:
+    # async: an attribute read needs no worker thread (a sync dependency costs one hop per request)
     return request.app.state.services
 
 
@@ -37,7 +38,7 @@ ServicesDep = Annotated[Services, Depends(get_services)]
 
 def _part(name: str):
     """``Depends`` on one part of the ``Services`` container."""
-    def get(services: ServicesDep):
+    async def get(services: ServicesDep):
         return getattr(services, name)
     return Depends(get)
 

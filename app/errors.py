@@ -32,6 +32,7 @@ class HmiError(Exception):
         self.message = message
         self.field = field
         self.extra = dict(extra or {})
+        self.headers: dict[str, str] = {}      # e.g. Retry-After of a 429
         if code:
             self.code = code
 
@@ -115,6 +116,7 @@ def install_handlers(app: FastAPI) -> None:
             body = envelope(exc.code, exc.message, exc.field)
             body["error"].update({k: v for k, v in exc.extra.items() if k not in body["error"]})
             response = JSONResponse(body, status_code=exc.status)
+        response.headers.update(exc.headers)
         return response
 
     @app.exception_handler(MeasuringError)

@@ -113,6 +113,11 @@ class Database:
         self._layout = offset_layout(extra_settable, basic_frames)
         self._write_turn = threading.RLock()   # held by this process's writing unit
         self._rotary_axes = tuple(rotary_axes)
+        # SQLite: the write count is read over a plain connection of each thread (no pool, no
+        # SQLAlchemy statement: a poll reads it several times; issue 30 item 2)
+        self._count_readers = threading.local()
+        self._count_connections: list[sqlite3.Connection] = []
+        self._count_lock = threading.Lock()
         if self.is_sqlite:
             # check_same_thread off: the pool hands connections to FastAPI's worker threads.
             self._engine = create_engine(self.url, connect_args={"check_same_thread": False})
@@ -181,9 +186,26 @@ class Database:
         raised in the same transaction as the unit's changes, so what a reader reads after reading
         the count is still the stored value while the count stays the same and may be cached
         under the count read."""
+        if self.is_sqlite and self.url.database not in (None, "", ":memory:"):
+            return self._sqlite_generation()
         with self._engine.connect() as connection:
             count = connection.scalar(select(Machine.writes).where(Machine.name == self.machine))
         return int(count or 0)
+
+    def _sqlite_generation(self) -> int:
+        connection = getattr(self._count_readers, "connection", None)
+        if connection is None:
+            # autocommit: each read is its own transaction and sees every committed write
+            connection = sqlite3.connect(str(self.path), isolation_level=None, check_same_thread=False)
+            connection.execute(f"PRAGMA busy_timeout={BUSY_TIMEOUT_MS}")
+            self._count_readers.connection = connection
+            with self._count_lock:
+                self._count_connections.append(connection)
+        try:
+            row = connection.execute(_WRITE_COUNT_SQL, (self.machine,)).fetchone()
+        except sqlite3.Error as exc:
+            raise StorageUnavailable(f"the database {self.where} cannot be read: {exc}") from exc
+        return int(row[0] or 0) if row is not None else 0
 
     def report_status(self, status: dict[str, Any]) -> None:
         """This HMI is alive, with ``status`` (alarms, mode, ...) for the plant view: its machines
@@ -205,6 +227,10 @@ class Database:
         return self._engine
 
     def close(self) -> None:
+        with self._count_lock:
+            for connection in self._count_connections:
+                connection.close()
+            self._count_connections.clear()
         self._engine.dispose()
 
     def __enter__(self) -> Database:
@@ -218,6 +244,10 @@ def _cause(exc: Exception) -> str:
     """The driver's own words (e.g. "database or disk is full"), without SQL and parameters."""
     original = getattr(exc, "orig", None) or exc
     return str(original).splitlines()[0] if str(original) else type(original).__name__
+
+
+_WRITE_COUNT_SQL = (f"SELECT {Machine.__table__.c.writes.name} FROM {Machine.__tablename__} "
+                   f"WHERE {Machine.__table__.c.name.name} = ?")
 
 
 def _configure_sqlite_connection(dbapi_connection: sqlite3.Connection, _connection_record: ConnectionPoolEntry) -> None:

@@ -628,29 +628,9 @@ def _ring_notes(frame: str, first_harmonic: str, skew_effective: bool, center_ob
     return notes
 
 
-def estimate_ring(touches: Sequence[RingTouch], diameter: float, probe: ProbeRecord, plane: Plane, *,
-                  frame: str = "probe", center: npt.ArrayLike | None = None, skew: npt.ArrayLike | None = None,
-                  wcs2bcs: Frame | None = None,
-                  sigma: float | None = None, first_harmonic: str = "convention",
-                  ball: str = "auto") -> RingEstimate:
-    """Ring centre, skew, every direction's effective radius and (when the chords observe it)
-    the ball radius from all touches, least squares.
-
-    ``touches``: RingTouch (``ring_touches`` of a RingCalibrationPoint, or any set: n directions
-    at any spindle angles). ``diameter``: the ring's known diameter. ``frame``: where the pre-
-    travel lives, "probe" (turns with SPOS) or "machine" (wave-1 simulator). ``center``: a known
-    ring centre (WCS point or (a, o)), ``skew``: a known skew (machine X/Y at 0°) — both optional,
-    they remove the corresponding unknowns. ``wcs2bcs``: measuring WCS -> BCS (= MCS). ``sigma``:
-    a-priori σ per touch for the covariance (else σ̂ from the residuals). ``first_harmonic``:
-    "convention" (default: the first harmonic of the pre-travel goes into skew resp. centre) or
-    "estimate" (separate it through the chord offsets: needs oblique chords). ``ball``: "auto"
-    (estimate the ball radius when the chords observe it, RADIUS_MIN_LEVER, else the nominal)
-    or "nominal" (``probe.ball_diameter``; the nominal is the start value either way).
-
-    Model, observability, convention and accuracy: the comment block above this class. Failures:
-    ValueError for bad input; MeasuringError NEEDS_SPOS when one spindle angle leaves centre and
-    skew inseparable, CIRCLE_UNDETERMINED for any other rank defect (e.g. directions on one axis).
-    """
+def _ring_input(diameter: float, probe: ProbeRecord, frame: str, first_harmonic: str,
+                ball: str) -> tuple[float, float]:
+    """(ring radius R, nominal ball radius r) after the checks of ``estimate_ring``'s options."""
     if frame not in PRETRAVEL_FRAMES:
         raise ValueError(f"frame must be one of {PRETRAVEL_FRAMES}, got {frame!r}")
     if first_harmonic not in ("convention", "estimate"):
@@ -663,31 +643,32 @@ def estimate_ring(touches: Sequence[RingTouch], diameter: float, probe: ProbeRec
     r_nom = probe.ball_diameter / 2.0
     if not big_r - r_nom > 0.0:
         raise ValueError(f"ring diameter {diameter} must exceed the ball diameter {probe.ball_diameter}")
-    touches = tuple(touches)
-    n = len(touches)
-    if n < 4:
-        raise MeasuringError(alarms.CIRCLE_PARAMETERS, f"a ring calibration needs 4 or more touches, got {n}")
-    to_mcs: Callable[[FloatArray], FloatArray] = (lambda v: v) if wcs2bcs is None else wcs2bcs.dir_child2parent
-    design = _ring_design(touches, plane, frame, to_mcs)
-    class_angles, cls = _classes(design.theta)
-    m = len(class_angles)
-    model = _RingModel(design, cls, m, big_r)
-    names = ("center_a", "center_o", "skew_X", "skew_Y", *[f"rho_{a:g}" for a in class_angles], "ball_radius")
+    return big_r, r_nom
 
-    # fixed parameters (a given centre/skew, the nominal ball radius) and the convention on ρ
-    x_fixed = np.zeros(model.n_par)
+
+def _ring_fixed(n_par: int, r_nom: float, plane: Plane, center: npt.ArrayLike | None,
+                skew: npt.ArrayLike | None) -> FloatArray:
+    """The fixed parameters: a given centre/skew, the nominal ball radius (the start value)."""
+    x_fixed = np.zeros(n_par)
     x_fixed[-1] = r_nom
     if center is not None:
         c_arr = np.asarray(center, dtype=float)
         x_fixed[:2] = plane.to_aop(c_arr)[:2] if c_arr.shape == (3,) else c_arr[:2]
     if skew is not None:
         x_fixed[2:4] = np.asarray(skew, dtype=float)[:2]
-    constrained = (frame == "probe" and skew is None) or (frame == "machine" and center is None)
+    return x_fixed
+
+
+def _solve_ring(model: _RingModel, design: Any, x_fixed: FloatArray, class_angles: Any,
+                center: npt.ArrayLike | None, skew: npt.ArrayLike | None, constrained: bool,
+                first_harmonic: str, ball: str) -> tuple[FloatArray, FloatArray, bool, bool]:
+    """Linear start (s = 0), then Gauss-Newton with the chord offsets; the first harmonic apart
+    (``first_harmonic`` "estimate"), the ball radius where the chords observe it.
+    -> (x, free columns, still constrained, ball radius estimated)."""
+    m = len(class_angles)
     th_rad = np.radians(class_angles)
     null = _null_space(np.vstack([np.cos(th_rad), np.sin(th_rad)]), m) if constrained else np.eye(m)
     t_mat = _free_columns(model.n_par, m, center, skew, null, radius_free=False)
-
-    # linear start (s = 0), then Gauss-Newton with the chord offsets
     f0, j0 = model.residual_jac(x_fixed, sagitta=False)
     if not _rank_ok(j0 @ t_mat):
         if len(set(np.round(design.phis, 6))) < 2 and center is None and skew is None:
@@ -711,15 +692,63 @@ def estimate_ring(touches: Sequence[RingTouch], diameter: float, probe: ProbeRec
     if radius_free:        # the chord sagittas observe the ball: the nominal is only the start value
         t_mat = _free_columns(model.n_par, m, center, skew, null, radius_free=True)
         x = _gauss_newton(model, x, t_mat)
+    return x, t_mat, constrained, radius_free
 
-    f, jac = model.residual_jac(x)
+
+def _ring_covariance(f: FloatArray, jac: FloatArray, t_mat: FloatArray, dof: int,
+                     sigma: float | None) -> tuple[float, FloatArray | None]:
+    """(σ used: a-priori or σ̂ from the residuals, covariance of all parameters or None)."""
     jz = jac @ t_mat
-    dof = n - t_mat.shape[1]
     s_used = float(sigma) if sigma is not None else (float(np.sqrt(np.sum(f * f) / dof)) if dof > 0 else float("nan"))
     cov = None
     if np.isfinite(s_used):
         cov = t_mat @ (s_used * s_used * np.linalg.inv(jz.T @ jz)) @ t_mat.T
         cov = 0.5 * (cov + cov.T)
+    return s_used, cov
+
+
+def estimate_ring(touches: Sequence[RingTouch], diameter: float, probe: ProbeRecord, plane: Plane, *,
+                  frame: str = "probe", center: npt.ArrayLike | None = None, skew: npt.ArrayLike | None = None,
+                  wcs2bcs: Frame | None = None,
+                  sigma: float | None = None, first_harmonic: str = "convention",
+                  ball: str = "auto") -> RingEstimate:
+    """Ring centre, skew, every direction's effective radius and (when the chords observe it)
+    the ball radius from all touches, least squares.
+
+    ``touches``: RingTouch (``ring_touches`` of a RingCalibrationPoint, or any set: n directions
+    at any spindle angles). ``diameter``: the ring's known diameter. ``frame``: where the pre-
+    travel lives, "probe" (turns with SPOS) or "machine" (wave-1 simulator). ``center``: a known
+    ring centre (WCS point or (a, o)), ``skew``: a known skew (machine X/Y at 0°) — both optional,
+    they remove the corresponding unknowns. ``wcs2bcs``: measuring WCS -> BCS (= MCS). ``sigma``:
+    a-priori σ per touch for the covariance (else σ̂ from the residuals). ``first_harmonic``:
+    "convention" (default: the first harmonic of the pre-travel goes into skew resp. centre) or
+    "estimate" (separate it through the chord offsets: needs oblique chords). ``ball``: "auto"
+    (estimate the ball radius when the chords observe it, RADIUS_MIN_LEVER, else the nominal)
+    or "nominal" (``probe.ball_diameter``; the nominal is the start value either way).
+
+    Model, observability, convention and accuracy: the comment block above this class. Failures:
+    ValueError for bad input; MeasuringError NEEDS_SPOS when one spindle angle leaves centre and
+    skew inseparable, CIRCLE_UNDETERMINED for any other rank defect (e.g. directions on one axis).
+    """
+    big_r, r_nom = _ring_input(diameter, probe, frame, first_harmonic, ball)
+    touches = tuple(touches)
+    n = len(touches)
+    if n < 4:
+        raise MeasuringError(alarms.CIRCLE_PARAMETERS, f"a ring calibration needs 4 or more touches, got {n}")
+    to_mcs: Callable[[FloatArray], FloatArray] = (lambda v: v) if wcs2bcs is None else wcs2bcs.dir_child2parent
+    design = _ring_design(touches, plane, frame, to_mcs)
+    class_angles, cls = _classes(design.theta)
+    m = len(class_angles)
+    model = _RingModel(design, cls, m, big_r)
+    names = ("center_a", "center_o", "skew_X", "skew_Y", *[f"rho_{a:g}" for a in class_angles], "ball_radius")
+
+    x_fixed = _ring_fixed(model.n_par, r_nom, plane, center, skew)
+    constrained = (frame == "probe" and skew is None) or (frame == "machine" and center is None)
+    x, t_mat, constrained, radius_free = _solve_ring(model, design, x_fixed, class_angles, center, skew,
+                                                     constrained, first_harmonic, ball)
+    f, jac = model.residual_jac(x)
+    dof = n - t_mat.shape[1]
+    s_used, cov = _ring_covariance(f, jac, t_mat, dof, sigma)
 
     mc, e, rho, r_hat = x[:2], x[2:4], x[4:4 + m], float(x[-1])
     axial = abs(centre_trigger_value(probe, -plane.infeed_unit, plane))

@@ -103,83 +103,96 @@ def correct(fix: FeatureFix, *, setpoints: dict[str, float], setpoint_angle: flo
     """
     if target == "measure_only":
         return Correction(target=target, before=target_frame, after=target_frame)
-
-    meas2bcs: Frame = chain.wcs2bcs
-
-    def dir_meas2parent(d_in_meas: npt.ArrayLike) -> FloatArray:
-        return target_parent2bcs.dir_parent2child(meas2bcs.dir_child2parent(d_in_meas))
-
-    def p_meas2parent(p_in_meas: npt.ArrayLike) -> FloatArray:
-        return target_parent2bcs.parent2child(meas2bcs.child2parent(p_in_meas))
-
-    rotation_old = target_frame.rotation
-    translation_old = target_frame.translation
-    rotation_new = rotation_old
-    rotation_changed = False
-    rotary = dict(target_frame.rotary)
-    rotary_axis: str | None = None
-    rotary_move: float | None = None
-    wants_angle = angle_correction not in (None, "none")
-    is_global = target.upper().startswith(GLOBAL_BASIC_PREFIX)
-
     if fix.normal is not None and fix.angle is not None:
         raise MeasuringError(alarms.FRAME_INTERNAL, "a feature fix cannot carry both a plane normal and an angle")
-
-    if fix.normal is not None and wants_angle:
-        if is_global:
-            raise MeasuringError(alarms.ZO_NUMBER,
-                                 f"{target}: a global basic frame cannot take a rotation (jog-measuring §4.2)")
-        normal_in_parent = dir_meas2parent(fix.normal)
-        normal_in_parent = normal_in_parent / np.linalg.norm(normal_in_parent)
-        rotation_new = _orient_rotation(rotation_old, normal_in_parent, plane)   # jog-measuring §2.9
-        rotation_changed = True
-
-    elif fix.angle is not None and wants_angle:
-        if is_global:
-            raise MeasuringError(alarms.ZO_NUMBER,
-                                 f"{target}: a global basic frame cannot take an angle correction "
-                                 "(jog-measuring §4.2, jog-measuring §11 Q21)")
-        k_name, k_sign = _signed_axis(fix.angle_axis or plane.infeed)
-        r_name = fix.reference_axis or plane.first
-        e_k = np.zeros(3)
-        e_k[axis_index(k_name)] = k_sign
-        e_r = np.zeros(3)
-        e_r[axis_index(r_name)] = 1.0
-        if abs(e_k @ e_r) > 0.0:
-            raise ValueError(f"reference axis {r_name} must differ from the angle axis {k_name}")
-        e_90 = np.cross(e_k, e_r)                 # +90° from the reference axis about k (measuring-math §0.1)
-        theta = np.radians(fix.angle)
-        u_meas = np.cos(theta) * e_r + np.sin(theta) * e_90
-        u_child = rotation_old.T @ dir_meas2parent(u_meas)   # measured direction, old child system
-        theta_child = float(np.degrees(np.arctan2(u_child @ e_90, u_child @ e_r)))
-        delta = _wrap180(theta_child - (setpoint_angle or 0.0))   # D = actual − setpoint (measuring-math §0.1)
-        if angle_correction == "rotation":
-            # measuring-math §2.2: R_new = R_old·Rot_k(Δθ)
-            rotation_new = rotation_old @ rot_axis(k_name, k_sign * delta)
-            rotation_changed = True
+    meas2parent = _Meas2Parent(chain.wcs2bcs, target_parent2bcs)
+    turn = _Turn(target_frame.rotation, dict(target_frame.rotary))
+    if angle_correction not in (None, "none") and (fix.normal is not None or fix.angle is not None):
+        if target.upper().startswith(GLOBAL_BASIC_PREFIX):
+            raise MeasuringError(alarms.ZO_NUMBER, f"{target}: a global basic frame cannot take "
+                                 + ("a rotation (jog-measuring §4.2)" if fix.normal is not None else
+                                    "an angle correction (jog-measuring §4.2, jog-measuring §11 Q21)"))
+        if fix.normal is not None:
+            normal_in_parent = meas2parent.direction(fix.normal)
+            normal_in_parent = normal_in_parent / np.linalg.norm(normal_in_parent)
+            turn.rotate(_orient_rotation(turn.rotation, normal_in_parent, plane))   # jog-measuring §2.9
         else:
-            axis = str(angle_correction)
-            if axis.upper() in ("X", "Y", "Z"):
-                raise ValueError(f"angle correction axis must be a rotary axis, got {axis!r}")
-            rotary[axis] = rotary.get(axis, 0.0) + delta        # jog-measuring §2.5.2, jog-measuring §11 Q8 (s = +1)
-            rotary_axis, rotary_move = axis, delta
-
+            _correct_angle(turn, fix, plane, meas2parent, setpoint_angle, str(angle_correction))
     coarse, fine = target_frame.coarse, target_frame.fine
-    determined = [a for a in fix.position] if translate else []
-    if determined:
-        point_meas = np.zeros(3) if fix.point is None else np.array(fix.point, dtype=float)
-        for axis in determined:
-            point_meas[axis_index(axis)] = float(fix.position[axis])
-        point_parent = p_meas2parent(point_meas)
-        point_child = rotation_new.T @ (point_parent - translation_old)   # after the rotation
-        d = np.zeros(3)
-        for axis in determined:
-            j = axis_index(axis)
-            d[j] = point_child[j] - float(setpoints.get(axis, 0.0))      # jog-measuring §2.5.1 d = c_a − s
-        coarse = translation_old + rotation_new @ d        # measuring-math §2.2 T_new = T + R·d
+    if translate and fix.position:
+        coarse = _translation(fix, setpoints, turn.rotation, target_frame.translation, meas2parent)
         fine = np.zeros(3)                                 # jog-measuring §4.4: coarse, fine cleared
-
-    rot = rpy_from_matrix(rotation_new) if rotation_changed else target_frame.rot
-    after = Frame(coarse=coarse, fine=fine, rot=rot, rotary=tuple(rotary.items()))
+    rot = rpy_from_matrix(turn.rotation) if turn.changed else target_frame.rot
+    after = Frame(coarse=coarse, fine=fine, rot=rot, rotary=tuple(turn.rotary.items()))
     return Correction(target=target, before=target_frame, after=after,
-                      rotary_axis=rotary_axis, rotary_move=rotary_move)
+                      rotary_axis=turn.rotary_axis, rotary_move=turn.rotary_move)
+
+
+@dataclass(frozen=True)
+class _Meas2Parent:
+    """From the measuring WCS to the target's parent system (through the BCS)."""
+
+    meas2bcs: Frame
+    parent2bcs: Frame
+
+    def direction(self, d_in_meas: npt.ArrayLike) -> FloatArray:
+        return self.parent2bcs.dir_parent2child(self.meas2bcs.dir_child2parent(d_in_meas))
+
+    def point(self, p_in_meas: npt.ArrayLike) -> FloatArray:
+        return self.parent2bcs.parent2child(self.meas2bcs.child2parent(p_in_meas))
+
+
+@dataclass
+class _Turn:
+    """The target's rotation and rotary offsets as the correction changes them."""
+
+    rotation: FloatArray
+    rotary: dict[str, float]
+    changed: bool = False
+    rotary_axis: str | None = None
+    rotary_move: float | None = None
+
+    def rotate(self, rotation: FloatArray) -> None:
+        self.rotation, self.changed = rotation, True
+
+
+def _correct_angle(turn: _Turn, fix: FeatureFix, plane: Plane, meas2parent: _Meas2Parent,
+                   setpoint_angle: float | None, angle_correction: str) -> None:
+    """An edge/angle fix: D = actual − setpoint (measuring-math §0.1) into the rotation about the
+    angle axis (measuring-math §2.2: R_new = R_old·Rot_k(Δθ)) or onto a rotary axis (jog-measuring §2.5.2)."""
+    assert fix.angle is not None
+    k_name, k_sign = _signed_axis(fix.angle_axis or plane.infeed)
+    r_name = fix.reference_axis or plane.first
+    e_k = np.zeros(3)
+    e_k[axis_index(k_name)] = k_sign
+    e_r = np.zeros(3)
+    e_r[axis_index(r_name)] = 1.0
+    if abs(e_k @ e_r) > 0.0:
+        raise ValueError(f"reference axis {r_name} must differ from the angle axis {k_name}")
+    e_90 = np.cross(e_k, e_r)                 # +90° from the reference axis about k (measuring-math §0.1)
+    theta = np.radians(fix.angle)
+    u_meas = np.cos(theta) * e_r + np.sin(theta) * e_90
+    u_child = turn.rotation.T @ meas2parent.direction(u_meas)   # measured direction, old child system
+    theta_child = float(np.degrees(np.arctan2(u_child @ e_90, u_child @ e_r)))
+    delta = _wrap180(theta_child - (setpoint_angle or 0.0))   # D = actual − setpoint (measuring-math §0.1)
+    if angle_correction == "rotation":
+        turn.rotate(turn.rotation @ rot_axis(k_name, k_sign * delta))
+        return
+    if angle_correction.upper() in ("X", "Y", "Z"):
+        raise ValueError(f"angle correction axis must be a rotary axis, got {angle_correction!r}")
+    turn.rotary[angle_correction] = turn.rotary.get(angle_correction, 0.0) + delta   # jog-measuring §11 Q8 (s = +1)
+    turn.rotary_axis, turn.rotary_move = angle_correction, delta
+
+
+def _translation(fix: FeatureFix, setpoints: dict[str, float], rotation_new: FloatArray,
+                 translation_old: FloatArray, meas2parent: _Meas2Parent) -> FloatArray:
+    """T_new = T + R·d (measuring-math §2.2), d = c_a − s per determined axis (jog-measuring §2.5.1)."""
+    point_meas = np.zeros(3) if fix.point is None else np.array(fix.point, dtype=float)
+    for axis in fix.position:
+        point_meas[axis_index(axis)] = float(fix.position[axis])
+    point_child = rotation_new.T @ (meas2parent.point(point_meas) - translation_old)   # after the rotation
+    d = np.zeros(3)
+    for axis in fix.position:
+        j = axis_index(axis)
+        d[j] = point_child[j] - float(setpoints.get(axis, 0.0))
+    return translation_old + rotation_new @ d

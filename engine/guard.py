@@ -25,6 +25,7 @@ from __future__ import annotations
 import math
 from collections.abc import Generator, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -59,6 +60,19 @@ def _polygon_sdf(points: FloatArray, polygon: FloatArray) -> FloatArray:
     return np.where(inside, -best, best)
 
 
+def _polygon_distance(px: float, py: float, edges: tuple[tuple[float, ...], ...]) -> float:
+    """``_polygon_sdf`` of one point (edges as ``Solid._plain`` has them)."""
+    best = math.inf
+    inside = False
+    for ax, ay, _bx, by, ex, ey, ee in edges:
+        wx, wy = px - ax, py - ay
+        t = min(max((wx * ex + wy * ey) / ee, 0.0), 1.0) if ee > 0.0 else 0.0
+        best = min(best, math.hypot(wx - t * ex, wy - t * ey))
+        if (ay > py) != (by > py) and px < ax + (py - ay) * ex / ey:     # even-odd rule
+            inside = not inside
+    return -best if inside else best
+
+
 @dataclass(frozen=True)
 class Solid:
     """An extrusion (``polygon`` (m, 2) or a circle of ``radius`` in local xy, ``half_height``
@@ -72,6 +86,42 @@ class Solid:
     half_height: float = 0.0
     polygon: FloatArray | None = None
     sphere: bool = False
+
+    @cached_property
+    def _plain(self) -> tuple[tuple[float, ...], tuple[float, ...], tuple[tuple[float, ...], ...] | None, float]:
+        """Centre, rotation (row-major), polygon edges (ax, ay, bx, by, ex, ey, |e|²) as floats, and
+        the radius of a ball about the centre that holds the solid (``distance``'s bound)."""
+        centre = tuple(float(v) for v in self.centre)
+        rotation = tuple(float(v) for v in np.asarray(self.rotation, dtype=float).ravel())
+        edges = None
+        if self.polygon is not None:
+            pts = [(float(x), float(y)) for x, y in np.asarray(self.polygon, dtype=float)]
+            edges = tuple((a[0], a[1], b[0], b[1], b[0] - a[0], b[1] - a[1], (b[0] - a[0]) ** 2 + (b[1] - a[1]) ** 2)
+                          for a, b in zip(pts, pts[1:] + pts[:1], strict=True))
+            reach = max(math.hypot(x, y) for x, y in pts)
+        else:
+            reach = self.radius
+        bound = self.radius if self.sphere else math.hypot(reach, self.half_height)
+        return centre, rotation, edges, bound
+
+    def lower_bound(self, x: float, y: float, z: float) -> float:
+        """A value the signed distance at (x, y, z) is never below: |p − centre| − bound."""
+        (cx, cy, cz), _, _, bound = self._plain
+        return math.sqrt((x - cx) ** 2 + (y - cy) ** 2 + (z - cz) ** 2) - bound
+
+    def distance(self, x: float, y: float, z: float) -> float:
+        """``sdf`` of one point in plain floats: the same formulas without numpy's cost per call
+        (the sphere tracing asks one point at a time, issue 30 item 3)."""
+        (cx, cy, cz), r, edges, _ = self._plain
+        dx, dy, dz = x - cx, y - cy, z - cz
+        qx = dx * r[0] + dy * r[3] + dz * r[6]          # q = (p − centre) · rotation
+        qy = dx * r[1] + dy * r[4] + dz * r[7]
+        qz = dx * r[2] + dy * r[5] + dz * r[8]
+        if self.sphere:
+            return math.sqrt(qx * qx + qy * qy + qz * qz) - self.radius
+        d2 = _polygon_distance(qx, qy, edges) if edges is not None else math.hypot(qx, qy) - self.radius
+        dzh = abs(qz) - self.half_height
+        return min(max(d2, dzh), 0.0) + math.hypot(max(d2, 0.0), max(dzh, 0.0))
 
     def sdf(self, points: FloatArray) -> FloatArray:
         q = (np.atleast_2d(points) - self.centre) @ self.rotation      # rows: local coordinates
@@ -103,6 +153,15 @@ class Body:
             value = np.maximum(value, -cut.sdf(points))
         return value
 
+    def distance(self, x: float, y: float, z: float) -> float:
+        """``sdf`` of one point; a cut-out too far away to matter (−sdf_N ≤ its bound − |p − c|
+        ≤ the value so far) is not evaluated."""
+        value = self.solid.distance(x, y, z)
+        for cut in self.cutouts:
+            if -cut.lower_bound(x, y, z) > value:
+                value = max(value, -cut.distance(x, y, z))
+        return value
+
 
 @dataclass(frozen=True)
 class ProtectionModel:
@@ -117,10 +176,17 @@ class ProtectionModel:
 
     def sdf(self, point: npt.ArrayLike) -> tuple[float, str]:
         """(distance, name of the nearest body) of one point."""
-        p = np.atleast_2d(np.asarray(point, dtype=float))
+        x, y, z = (float(v) for v in np.asarray(point, dtype=float).ravel()[:3])
+        return self.distance(x, y, z)
+
+    def distance(self, x: float, y: float, z: float) -> tuple[float, str]:
+        """``sdf`` in plain floats; a body whose bound is no nearer than the best so far is skipped
+        (it cannot be the nearest)."""
         best, name = math.inf, ""
         for body in self.bodies:
-            v = float(body.sdf(p)[0])
+            if body.solid.lower_bound(x, y, z) >= best:
+                continue
+            v = body.distance(x, y, z)
             if v < best:
                 best, name = v, body.name
         return best, name
@@ -131,25 +197,30 @@ def first_contact(model: ProtectionModel, c0: npt.ArrayLike, c1: npt.ArrayLike, 
     """First s in [0, |c1 − c0|] where a ball of ``radius`` moving c0 → c1 touches the model,
     with the body's name; None when the way is free. A ball that starts in contact and moves away
     or slides along the surface is free until its next contact; pressing deeper is s = 0."""
-    a, b = np.asarray(c0, dtype=float), np.asarray(c1, dtype=float)
-    length = float(np.linalg.norm(b - a))
+    ax, ay, az = (float(v) for v in np.asarray(c0, dtype=float))
+    bx, by, bz = (float(v) for v in np.asarray(c1, dtype=float))
+    length = math.sqrt((bx - ax) ** 2 + (by - ay) ** 2 + (bz - az) ** 2)
     if length <= 0.0 or not model.bodies:
         return None
-    d = (b - a) / length
-    g, name = model.sdf(a)
+    dx, dy, dz = (bx - ax) / length, (by - ay) / length, (bz - az) / length
+
+    def at(s: float) -> tuple[float, str]:
+        return model.distance(ax + s * dx, ay + s * dy, az + s * dz)
+
+    g, name = at(0.0)
     s = 0.0
     if g - radius <= CONTACT_EPS:
         step = 1e-6
-        ahead, _ = model.sdf(a + step * d)
+        ahead, _ = at(step)
         if ahead < g - 1e-6 * step:
             return 0.0, name
         while s < length and g - radius <= CONTACT_EPS:
             s = min(length, s + UNSTICK_STEP)
-            g, name = model.sdf(a + s * d)
+            g, name = at(s)
         if g - radius <= CONTACT_EPS:
             return None
     for _ in range(MAX_TRACE_STEPS):
-        g, name = model.sdf(a + s * d)
+        g, name = at(s)
         gap = g - radius
         if gap <= CONTACT_EPS:
             return s, name

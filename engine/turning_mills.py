@@ -77,139 +77,170 @@ def mill_program(call: Cycle982, start: npt.ArrayLike, ctx: LatheContext, label:
     variant, tool = check_982(call, ctx)
     if tool.family not in ("mill", "drill") or variant.kind == "calibrate":
         raise ValueError("mill_program measures mills and drills")
-    _, record = tool_probe_record(call, variant, ctx)
-    fa = check_fa(call.fa)
-    feed = measuring_feed(call.vms, fa)
-    p0 = np.asarray(start, float)
-    m = LatheMotion(p0, ctx, "WCS" if variant.workpiece else "MCS")
-    touches = []
-    use_spos = not ctx.bit(20)
-    r = tool.effective("radius")
-    sta1 = float(call.sta1)
-
-    def spos(angle: float, tag: str) -> LatheSteps:
-        if use_spos:
-            yield from m.spos(angle, f"{tag} SPOS")
-
-    def angles(base: float) -> tuple[float, ...]:
-        return (base, base + 180.0 + float(call.cora)) if variant.reversal else (base,)
-
-    def probe_at(k: str, base: float, role: str, distance: float, expected: float | None) -> LatheSteps:
-        for i, ang in enumerate(angles(base)):
-            yield from spos(ang, role)
-            tag = f"{role} {k}" + (" reversal" if i else "")
-            touches.append((yield from m.touch(k, distance, feed, call.nmsp, tag, expected=expected, role=role)))
-
-    def finish(info: dict[str, Any]) -> LathePoint:
-        return LathePoint(cycle=call.cycle, mvar=call.mvar, coords=m.coords, start=p0.copy(),
-                          touches=tuple(touches), info=info)
-
-    yield from spos(sta1, f"{label}1")                         # SPOS _STA1 first (3-A) unless _CHBIT[20]=1
+    run = _MillRun(call, variant, tool, start, ctx, label)
+    yield from run.spos(run.sta1, f"{label}1")                 # SPOS _STA1 first (3-A) unless _CHBIT[20]=1
     app = _applicate_axis(ctx)
     if app is not None:                                         # drill, SD 42950=0 (turning.md §3.4)
-        d = direction_of_md(call.md) if variant.incremental else -1
-        if d != -1:
-            raise MeasuringError(alarms.TOOL_TIP_POSITION, "a drill's length is measured travelling towards its tip (-)")
-        if not variant.incremental:
-            travel_direction(float(p0["XYZ".index(app)]), 0, 0.0, tp_face(record, key(app, -1)),
-                             tp_face(record, key(app, 1)), fa, (-1,), what="drill")
-            other = other_plane_axis(app)
-            yield from m.move_axis(other, tp_centre(record, other), f"{label}1 tip on the probe centre")
-            yield from m.move_axis(app, tp_face(record, key(app, -1)) + fa, f"{label}1 start of probing")
-        yield from probe_at(key(app, -1), sta1, f"{label}1", 2.0 * fa, None if variant.incremental else fa)
-        if variant.incremental:
-            yield from m.move(m.start, "back to the start", returning=True)
-        return finish({"tool_axis": app, "applicate": True, "radius": 0.0})
+        return (yield from run.drill_on_applicate(app))
+    run.place_axes()
+    if variant.incremental:
+        return (yield from run.incremental())
+    if variant.kind == "measure":
+        return (yield from run.measure())
+    return (yield from run.automatic())
 
-    t_ax, q_ax = _axes(variant.radial)
-    drill = tool.family == "drill"
-    c_t, c_q = tp_centre(record, t_ax), tp_centre(record, q_ax)
-    f_t = tp_face(record, key(t_ax, -1))            # the face the end face touches travelling −T
 
-    def end_touch(role: str, sigma: int, base: float) -> LatheSteps:
+class _MillRun:
+    """One CYCLE982 run of a mill or drill: the motion, the touches so far and the probe's record."""
+
+    def __init__(self, call: Cycle982, variant: Any, tool: Any, start: npt.ArrayLike, ctx: LatheContext,
+                 label: str) -> None:
+        _, self.record = tool_probe_record(call, variant, ctx)
+        self.call, self.variant, self.label = call, variant, label
+        self.fa = check_fa(call.fa)
+        self.feed = measuring_feed(call.vms, self.fa)
+        self.p0 = np.asarray(start, float)
+        self.m = LatheMotion(self.p0, ctx, "WCS" if variant.workpiece else "MCS")
+        self.touches: list[LatheTouch] = []
+        self.use_spos = not ctx.bit(20)
+        self.r = tool.effective("radius")
+        self.drill = tool.family == "drill"
+        self.sta1 = float(call.sta1)
+
+    def place_axes(self) -> None:
+        """Tool axis T and radius axis Q, the probe's centre and the end face's face, where the
+        axes stand (after the first SPOS; not for a drill on the applicate)."""
+        variant = self.variant
+        self.t_ax, self.q_ax = _axes(variant.radial)
+        self.c_t, self.c_q = tp_centre(self.record, self.t_ax), tp_centre(self.record, self.q_ax)
+        self.f_t = tp_face(self.record, key(self.t_ax, -1))    # the face the end face touches travelling −T
+        self.q0, self.t0 = float(self.p0["XYZ".index(self.q_ax)]), float(self.p0["XYZ".index(self.t_ax)])
+        # the same edge on the opposite side [L18050–L18060]
+        self.second = self.sta1 if variant.reversal else self.sta1 + 180.0
+        self.info = {"tool_axis": self.t_ax, "radius_axis": self.q_ax, "radius": self.r}
+
+    # --- the touches -------------------------------------------------------------------------
+    def spos(self, angle: float, tag: str) -> LatheSteps:
+        if self.use_spos:
+            yield from self.m.spos(angle, f"{tag} SPOS")
+
+    def angles(self, base: float) -> tuple[float, ...]:
+        return (base, base + 180.0 + float(self.call.cora)) if self.variant.reversal else (base,)
+
+    def probe_at(self, k: str, base: float, role: str, distance: float, expected: float | None) -> LatheSteps:
+        for i, ang in enumerate(self.angles(base)):
+            yield from self.spos(ang, role)
+            tag = f"{role} {k}" + (" reversal" if i else "")
+            self.touches.append((yield from self.m.touch(k, distance, self.feed, self.call.nmsp, tag,
+                                                         expected=expected, role=role)))
+
+    def finish(self, info: dict[str, Any]) -> LathePoint:
+        return LathePoint(cycle=self.call.cycle, mvar=self.call.mvar, coords=self.m.coords, start=self.p0.copy(),
+                          touches=tuple(self.touches), info=info)
+
+    def end_touch(self, role: str, sigma: int, base: float) -> LatheSteps:
         """End face: out along T to the start of probing, then the measuring point (the edge
         on the probe side, axis − σ·R) on the probe centre; probe −T."""
-        yield from m.move_axis(t_ax, max(float(m.pos["XYZ".index(t_ax)]), f_t + fa), f"{role} clear in {t_ax}")
-        yield from m.move_axis(q_ax, c_q + sigma * r, f"{role} measuring point on the probe centre")
-        yield from m.move_axis(t_ax, f_t + fa, f"{role} start of probing")
-        yield from probe_at(key(t_ax, -1), base, role, 2.0 * fa, fa)
+        m, t_ax, fa = self.m, self.t_ax, self.fa
+        yield from m.move_axis(t_ax, max(float(m.pos["XYZ".index(t_ax)]), self.f_t + fa), f"{role} clear in {t_ax}")
+        yield from m.move_axis(self.q_ax, self.c_q + sigma * self.r, f"{role} measuring point on the probe centre")
+        yield from m.move_axis(t_ax, self.f_t + fa, f"{role} start of probing")
+        yield from self.probe_at(key(t_ax, -1), base, role, 2.0 * fa, fa)
 
-    def side_touch(role: str, d: int, base: float) -> LatheSteps:
+    def side_touch(self, role: str, d: int, base: float) -> LatheSteps:
         """Periphery travelling d on Q: Q to the start of probing (cutter clear of the probe in T
         or already beside it), then the cutter's end to the probe centre in T; probe d."""
-        f_q = tp_face(record, key(q_ax, d))
-        yield from m.move_axis(q_ax, f_q - d * (r + fa), f"{role} start of probing")
-        yield from m.move_axis(t_ax, c_t, f"{role} cutter end at the probe centre")
-        yield from probe_at(key(q_ax, d), base, role, 2.0 * fa, fa)
+        f_q = tp_face(self.record, key(self.q_ax, d))
+        yield from self.m.move_axis(self.q_ax, f_q - d * (self.r + self.fa), f"{role} start of probing")
+        yield from self.m.move_axis(self.t_ax, self.c_t, f"{role} cutter end at the probe centre")
+        yield from self.probe_at(key(self.q_ax, d), base, role, 2.0 * self.fa, self.fa)
 
-    def round_to(d_next: int, role: str) -> LatheSteps:
+    def round_to(self, d_next: int, role: str) -> LatheSteps:
         """Round the probe: out along +T beyond the probe, across Q to the next start of probing."""
-        yield from m.move_axis(t_ax, f_t + fa, f"{role} round the probe ({t_ax})")
-        yield from m.move_axis(q_ax, tp_face(record, key(q_ax, d_next)) - d_next * (r + fa),
-                               f"{role} round the probe ({q_ax})")
+        yield from self.m.move_axis(self.t_ax, self.f_t + self.fa, f"{role} round the probe ({self.t_ax})")
+        yield from self.m.move_axis(self.q_ax, tp_face(self.record, key(self.q_ax, d_next)) - d_next * (self.r + self.fa),
+                                    f"{role} round the probe ({self.q_ax})")
 
-    q0, t0 = float(p0["XYZ".index(q_ax)]), float(p0["XYZ".index(t_ax)])
-    second = sta1 if variant.reversal else sta1 + 180.0   # same edge on the opposite side [L18050–L18060]
-    info = {"tool_axis": t_ax, "radius_axis": q_ax, "radius": r}
+    # --- the variants ------------------------------------------------------------------------
+    def drill_on_applicate(self, app: str) -> LatheProgram:
+        """A drill with SD 42950=0: its length on the applicate, travelling towards its tip (turning.md §3.4)."""
+        call, fa, record, label = self.call, self.fa, self.record, self.label
+        incremental = self.variant.incremental
+        d = direction_of_md(call.md) if incremental else -1
+        if d != -1:
+            raise MeasuringError(alarms.TOOL_TIP_POSITION, "a drill's length is measured travelling towards its tip (-)")
+        if not incremental:
+            travel_direction(float(self.p0["XYZ".index(app)]), 0, 0.0, tp_face(record, key(app, -1)),
+                             tp_face(record, key(app, 1)), fa, (-1,), what="drill")
+            other = other_plane_axis(app)
+            yield from self.m.move_axis(other, tp_centre(record, other), f"{label}1 tip on the probe centre")
+            yield from self.m.move_axis(app, tp_face(record, key(app, -1)) + fa, f"{label}1 start of probing")
+        yield from self.probe_at(key(app, -1), self.sta1, f"{label}1", 2.0 * fa, None if incremental else fa)
+        if incremental:
+            yield from self.m.move(self.m.start, "back to the start", returning=True)
+        return self.finish({"tool_axis": app, "applicate": True, "radius": 0.0})
 
-    if variant.incremental:
+    def incremental(self) -> LatheProgram:
+        call, t_ax = self.call, self.t_ax
         a = axis_of_ma(call.ma, (1, 2))
         d = direction_of_md(call.md)
         if a == t_ax and d != -1:
             raise MeasuringError(alarms.TOOL_TIP_POSITION, f"the end face is measured travelling {key(t_ax, -1)}")
-        if a == t_ax and variant.d4 == 1:
+        if a == t_ax and self.variant.d4 == 1:
             raise MeasuringError(alarms.WRONG_VARIANT, f"the radius does not lie on _MA={call.ma} (turning.md §3.1)")
-        yield from probe_at(key(a, d), sta1, f"{label}1", 2.0 * fa, None)
-        yield from m.move(m.start, "back to the start", returning=True)
-        return finish({**info, "measuring_axis": a})
+        yield from self.probe_at(key(a, d), self.sta1, f"{self.label}1", 2.0 * self.fa, None)
+        yield from self.m.move(self.m.start, "back to the start", returning=True)
+        return self.finish({**self.info, "measuring_axis": a})
 
-    if variant.kind == "measure":
+    def measure(self) -> LatheProgram:
+        call, record, label, t_ax, q_ax, fa = self.call, self.record, self.label, self.t_ax, self.q_ax, self.fa
         a = axis_of_ma(call.ma, (1, 2))
         if a == t_ax:
-            if variant.d4 != 0:
+            if self.variant.d4 != 0:
                 raise MeasuringError(alarms.WRONG_VARIANT,
                                      f"_MVAR={call.mvar}: the radius does not lie on _MA={call.ma} (turning.md §3.1)")
-            travel_direction(t0, 0, 0.0, f_t, tp_face(record, key(t_ax, 1)), fa, (-1,), what="cutter")
-            sigma = 1 if q0 >= c_q else -1
-            yield from end_touch(f"{label}1", sigma, sta1)
+            travel_direction(self.t0, 0, 0.0, self.f_t, tp_face(record, key(t_ax, 1)), fa, (-1,), what="cutter")
+            sigma = 1 if self.q0 >= self.c_q else -1
+            yield from self.end_touch(f"{label}1", sigma, self.sta1)
         else:
-            d1 = travel_direction(q0, 0, r, tp_face(record, key(q_ax, -1)), tp_face(record, key(q_ax, 1)), fa,
-                                  what="cutter")
-            yield from side_touch(f"{label}1", d1, sta1)
-            if variant.d4 == 2:
-                yield from round_to(-d1, f"{label}2")
-                yield from side_touch(f"{label}2", -d1, second)
-        return finish({**info, "measuring_axis": a})
+            d1 = travel_direction(self.q0, 0, self.r, tp_face(record, key(q_ax, -1)), tp_face(record, key(q_ax, 1)),
+                                  fa, what="cutter")
+            yield from self.side_touch(f"{label}1", d1, self.sta1)
+            if self.variant.d4 == 2:
+                yield from self.round_to(-d1, f"{label}2")
+                yield from self.side_touch(f"{label}2", -d1, self.second)
+        return self.finish({**self.info, "measuring_axis": a})
 
-    # automatic (digit 1 = 2, digit 4 = 0): Z first, then X [L18732–L18740]; back Z, then X
-    travel_direction(t0, 0, 0.0, f_t, tp_face(record, key(t_ax, 1)), fa, (-1,), what="cutter")
-    dq = travel_direction(q0, 0, r, tp_face(record, key(q_ax, -1)), tp_face(record, key(q_ax, 1)), fa, what="cutter")
-    sigma = 1 if q0 >= c_q else -1
-    two = r > 0.0 and not drill
+    def automatic(self) -> LatheProgram:
+        """Digit 1 = 2, digit 4 = 0: Z first, then X [L18732–L18740]; back Z, then X."""
+        record, label, t_ax, q_ax, fa = self.record, self.label, self.t_ax, self.q_ax, self.fa
+        travel_direction(self.t0, 0, 0.0, self.f_t, tp_face(record, key(t_ax, 1)), fa, (-1,), what="cutter")
+        dq = travel_direction(self.q0, 0, self.r, tp_face(record, key(q_ax, -1)), tp_face(record, key(q_ax, 1)), fa,
+                              what="cutter")
+        two = self.r > 0.0 and not self.drill
+        if self.drill:
+            yield from self.end_touch(f"{label}1", 1 if self.q0 >= self.c_q else -1, self.sta1)
+        elif t_ax == "Z":                               # axial: P1/P2 end face (L2), P3/P4 periphery (L1, R)
+            yield from self._ends(f"{label}1", f"{label}2", two)
+            yield from self._sides(f"{label}3", f"{label}4", dq, two)
+        else:                                           # radial: P1/P2 periphery (L2, R), P3/P4 end face (L1)
+            yield from self._sides(f"{label}1", f"{label}2", dq, two)
+            yield from self._ends(f"{label}3", f"{label}4", two)
+        yield from self.m.move_axis("Z", float(self.p0[2]), "back to the start Z", returning=True)
+        yield from self.m.move_axis("X", float(self.p0[0]), "back to the start X", returning=True)
+        return self.finish({**self.info, "automatic": True})
 
-    def ends(first: str, second_role: str) -> LatheSteps:
-        s_now = 1 if float(m.pos["XYZ".index(q_ax)]) >= c_q else -1
-        yield from end_touch(first, s_now, sta1)
+    def _ends(self, first: str, second_role: str, two: bool) -> LatheSteps:
+        s_now = 1 if float(self.m.pos["XYZ".index(self.q_ax)]) >= self.c_q else -1
+        yield from self.end_touch(first, s_now, self.sta1)
         if two:
-            yield from end_touch(second_role, -s_now, second)
+            yield from self.end_touch(second_role, -s_now, self.second)
 
-    def sides(first: str, second_role: str) -> LatheSteps:
-        yield from side_touch(first, dq, sta1)
+    def _sides(self, first: str, second_role: str, dq: int, two: bool) -> LatheSteps:
+        yield from self.side_touch(first, dq, self.sta1)
         if two:
-            yield from round_to(-dq, second_role)
-            yield from side_touch(second_role, -dq, second)
-
-    if drill:
-        yield from end_touch(f"{label}1", sigma, sta1)
-    elif t_ax == "Z":                                   # axial: P1/P2 end face (L2), P3/P4 periphery (L1, R)
-        yield from ends(f"{label}1", f"{label}2")
-        yield from sides(f"{label}3", f"{label}4")
-    else:                                               # radial: P1/P2 periphery (L2, R), P3/P4 end face (L1)
-        yield from sides(f"{label}1", f"{label}2")
-        yield from ends(f"{label}3", f"{label}4")
-    yield from m.move_axis("Z", float(p0[2]), "back to the start Z", returning=True)
-    yield from m.move_axis("X", float(p0[0]), "back to the start X", returning=True)
-    return finish({**info, "automatic": True})
+            yield from self.round_to(-dq, second_role)
+            yield from self.side_touch(second_role, -dq, self.second)
 
 
 def _p_value(touches: Sequence[LatheTouch], record: Mapping[str, float], tool: LatheTool) -> float:

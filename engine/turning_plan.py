@@ -18,8 +18,9 @@ from __future__ import annotations
 
 import contextlib
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
+from functools import partial
 from typing import Any, Literal, overload
 
 import numpy as np
@@ -182,12 +183,13 @@ ZO_NAMES = {**{f"G{54 + i}": 1 + i for i in range(4)}, **{f"G{500 + n}": n for n
             **{f"BASIC_{n}": 1011 + n for n in range(16)}, "BASIC_REF": 2000}
 
 
-def _target(params: Mapping[str, Any], task: str) -> str | dict[str, Any]:
+def _target(params: Mapping[str, Any], zero_offsets: bool) -> str | dict[str, Any]:
+    """``measure_only``, a zero offset (where the task may write one) or a tool object."""
     t = params.get("target", "measure_only")
     if t in (None, "measure_only"):
         return "measure_only"
     if isinstance(t, str):
-        if task != "lathe.point" or t.upper() not in ZO_NAMES:
+        if not zero_offsets or t.upper() not in ZO_NAMES:
             raise ParamError("target", f"target {t!r} is not a zero offset of lathe.point "
                                        f"(G54..G57, G505..G599, BASIC_0..BASIC_15, BASIC_REF) nor a tool object")
         return t.upper()
@@ -216,13 +218,14 @@ def validate_lathe_params(task: str, params: Mapping[str, Any] | None) -> dict[s
     length_radius, ``reversal``, ``position`` axial / radial, ``start_angle`` (_STA1),
     ``correction_angle`` (_CORA). Values are taken in the units the cycles read them (turning §10.2
     "Units": ``setpoint`` and the 974/994 bands are diameters on X with DIAMON): nothing is
-    converted here.
+    converted here. The task's own params are its entry's in ``LATHE_TASK_RULES``.
     """
-    if task not in LATHE_TASKS:
+    rules = LATHE_TASK_RULES.get(task)
+    if rules is None:
         raise ParamError("task", f"unknown lathe task {task!r}")
     p = dict(params or {})
     out: dict[str, Any] = {"probe": _int(p, "probe", 1, 1), "measurements": _int(p, "measurements", 1, 1),
-                 "tolerance": _tolerance(task, p)}
+                           "tolerance": _tolerance(task, p)}
     fa = _number(p, "measuring_path", 2.0, required=True)     # null/"": refused, not a TypeError
     if fa <= 0.0:
         raise ParamError("measuring_path", f"measuring_path must be > 0, got {fa:g}")
@@ -231,74 +234,100 @@ def validate_lathe_params(task: str, params: Mapping[str, Any] | None) -> dict[s
     if feed < 0.0:
         raise ParamError("feed", f"feed must be >= 0 (0 = the cycle's default), got {feed:g}")
     out["feed"] = feed
-    if task in ("lathe.toolprobe.calibrate", "lathe.tool.measure", "lathe.tool.auto"):
-        out["reference"] = _choice(p, "reference", ("machine", "workpiece"), "machine")
-        if task != "lathe.tool.auto":
-            out["axis"] = _choice(p, "axis", ("Z", "X"), None, required=True)
-            out["incremental"] = _bool(p, "incremental", False)
-            if out["incremental"]:
-                out["direction"] = _choice(p, "direction", ("+", "-"), None, required=True)
-        if task != "lathe.toolprobe.calibrate":
-            out["compensation"] = _choice(p, "compensation", ("geometry", "wear"), "geometry")
-            out["quantity"] = _choice(p, "quantity", ("length", "radius", "length_radius"), "length")
-            out["reversal"] = _bool(p, "reversal", False)
-            out["position"] = _choice(p, "position", ("axial", "radial"), "axial")
-            out["start_angle"] = _number(p, "start_angle", 0.0, required=True)
-            out["correction_angle"] = _number(p, "correction_angle", 0.0, required=True)
-            if task == "lathe.tool.auto" and out["quantity"] != "length":
-                raise ParamError("quantity", "lathe.tool.auto determines every quantity itself")
-            if out.get("incremental") and out["quantity"] == "length_radius":
-                raise ParamError("quantity", "length and radius cannot be measured incrementally")
-    elif task == "lathe.probe.groove":
-        out["groove"] = _groove(p)
-        out["axis"] = _choice(p, "axis", ("Z", "X"), None, required=True)
-        out["direction"] = _choice(p, "direction", ("+", "-", "both"), None, required=True)
-        out["skew"] = _bool(p, "skew", False)
-        out["ball_diameter"] = _bool(p, "ball_diameter", False)
-        if out["direction"] != "both" and (out["skew"] or out["ball_diameter"]):
-            name = "skew" if out["skew"] else "ball_diameter"
-            raise ParamError(name, f"{name} needs direction \"both\": in one direction it cannot be determined "
-                                   "[L20293]")
-    elif task == "lathe.probe.surface":
-        out["axis"] = _choice(p, "axis", ("Z", "X", "Y"), None, required=True)
-        out["direction"] = _choice(p, "direction", ("+", "-"), None, required=True)
-        out["setpoint"] = _number(p, "setpoint", required=True)
-    else:
-        out["axis"] = _choice(p, "axis", ("Z", "X", "Y"), None, required=True)
-        out["setpoint"] = _number(p, "setpoint", required=True)
-        tol_set = out["tolerance"].get("setpoint")
-        if tol_set is not None and tol_set != out["setpoint"]:
-            raise ParamError("tolerance.setpoint", "tolerance.setpoint is not used: the task's setpoint is the "
-                                                   "nominal; a different value is refused (turning.md §10.2)")
-        out["target"] = _target(p, task)
-        if task == "lathe.point":
-            out["reversal"] = _bool(p, "reversal", False)
-            angle = _number(p, "start_angle", 0.0, required=True)
-            if not 0.0 <= angle <= 360.0:
-                raise ParamError("start_angle", f"start_angle must be 0..360 deg, got {angle:g}")
-            out["start_angle"] = angle
-            if out["reversal"] and isinstance(out["target"], str) and out["target"] != "measure_only":
-                raise ParamError("reversal", "the reversal measurement corrects a tool, not a zero offset")
-        else:
-            if out["setpoint"] <= 0.0:
-                raise ParamError("setpoint", f"setpoint (the diameter) must be > 0, got {out['setpoint']:g}")
-            out["inside"] = _bool(p, "inside", False)
-            out["use_ball_diameter"] = _bool(p, "use_ball_diameter", False)
-            zone = p.get("zone")
-            if zone is not None:
-                if not isinstance(zone, Mapping):
-                    raise ParamError("zone", "zone must be an object {\"Z\": _SZA, \"X\": _SZO}")
-                z = {k: _number(zone, k, field_name=f"zone.{k}") for k in ("Z", "X") if k in zone}
-                extra = [k for k in zone if k not in ("Z", "X")]
-                if extra:
-                    raise ParamError(f"zone.{extra[0]}", "zone has the keys Z and X only")
-                zone = z
-            if not out["inside"] and (zone is None or "Z" not in zone or "X" not in zone):
-                raise ParamError("zone", "an outside diameter needs the protection zone {\"Z\", \"X\"} for its detour")
-            if out["inside"] and zone is not None and "Z" not in zone:
-                raise ParamError("zone.Z", "an inside diameter with a zone leaves the bore via zone.Z")
-            out["zone"] = zone
+    rules.params(p, out)
     return out
+
+
+def _tool_params(p: Mapping[str, Any], out: dict[str, Any], *, calibrate: bool = False, auto: bool = False) -> None:
+    """CYCLE982: the tool probe's calibration (``calibrate``), a tool measured, or automatically (``auto``)."""
+    out["reference"] = _choice(p, "reference", ("machine", "workpiece"), "machine")
+    if not auto:
+        out["axis"] = _choice(p, "axis", ("Z", "X"), None, required=True)
+        out["incremental"] = _bool(p, "incremental", False)
+        if out["incremental"]:
+            out["direction"] = _choice(p, "direction", ("+", "-"), None, required=True)
+    if calibrate:
+        return
+    out["compensation"] = _choice(p, "compensation", ("geometry", "wear"), "geometry")
+    out["quantity"] = _choice(p, "quantity", ("length", "radius", "length_radius"), "length")
+    out["reversal"] = _bool(p, "reversal", False)
+    out["position"] = _choice(p, "position", ("axial", "radial"), "axial")
+    out["start_angle"] = _number(p, "start_angle", 0.0, required=True)
+    out["correction_angle"] = _number(p, "correction_angle", 0.0, required=True)
+    if auto and out["quantity"] != "length":
+        raise ParamError("quantity", "lathe.tool.auto determines every quantity itself")
+    if out.get("incremental") and out["quantity"] == "length_radius":
+        raise ParamError("quantity", "length and radius cannot be measured incrementally")
+
+
+def _groove_params(p: Mapping[str, Any], out: dict[str, Any]) -> None:
+    """CYCLE973 in a reference groove."""
+    out["groove"] = _groove(p)
+    out["axis"] = _choice(p, "axis", ("Z", "X"), None, required=True)
+    out["direction"] = _choice(p, "direction", ("+", "-", "both"), None, required=True)
+    out["skew"] = _bool(p, "skew", False)
+    out["ball_diameter"] = _bool(p, "ball_diameter", False)
+    if out["direction"] != "both" and (out["skew"] or out["ball_diameter"]):
+        name = "skew" if out["skew"] else "ball_diameter"
+        raise ParamError(name, f"{name} needs direction \"both\": in one direction it cannot be determined "
+                               "[L20293]")
+
+
+def _surface_params(p: Mapping[str, Any], out: dict[str, Any]) -> None:
+    """CYCLE973 on a surface."""
+    out["axis"] = _choice(p, "axis", ("Z", "X", "Y"), None, required=True)
+    out["direction"] = _choice(p, "direction", ("+", "-"), None, required=True)
+    out["setpoint"] = _number(p, "setpoint", required=True)
+
+
+def _workpiece_params(p: Mapping[str, Any], out: dict[str, Any], *, zero_offsets: bool) -> None:
+    """CYCLE974/994: axis, setpoint (the nominal; a different tolerance.setpoint is refused), target."""
+    out["axis"] = _choice(p, "axis", ("Z", "X", "Y"), None, required=True)
+    out["setpoint"] = _number(p, "setpoint", required=True)
+    tol_set = out["tolerance"].get("setpoint")
+    if tol_set is not None and tol_set != out["setpoint"]:
+        raise ParamError("tolerance.setpoint", "tolerance.setpoint is not used: the task's setpoint is the "
+                                               "nominal; a different value is refused (turning.md §10.2)")
+    out["target"] = _target(p, zero_offsets)
+
+
+def _point_params(p: Mapping[str, Any], out: dict[str, Any]) -> None:
+    """CYCLE974: one point; a zero offset or a tool as target, the reversal measurement."""
+    _workpiece_params(p, out, zero_offsets=True)
+    out["reversal"] = _bool(p, "reversal", False)
+    angle = _number(p, "start_angle", 0.0, required=True)
+    if not 0.0 <= angle <= 360.0:
+        raise ParamError("start_angle", f"start_angle must be 0..360 deg, got {angle:g}")
+    out["start_angle"] = angle
+    if out["reversal"] and isinstance(out["target"], str) and out["target"] != "measure_only":
+        raise ParamError("reversal", "the reversal measurement corrects a tool, not a zero offset")
+
+
+def _two_point_params(p: Mapping[str, Any], out: dict[str, Any]) -> None:
+    """CYCLE994: a diameter between two points, inside or outside, with its protection zone."""
+    _workpiece_params(p, out, zero_offsets=False)
+    if out["setpoint"] <= 0.0:
+        raise ParamError("setpoint", f"setpoint (the diameter) must be > 0, got {out['setpoint']:g}")
+    out["inside"] = _bool(p, "inside", False)
+    out["use_ball_diameter"] = _bool(p, "use_ball_diameter", False)
+    zone = _zone(p.get("zone"))
+    if not out["inside"] and (zone is None or "Z" not in zone or "X" not in zone):
+        raise ParamError("zone", "an outside diameter needs the protection zone {\"Z\", \"X\"} for its detour")
+    if out["inside"] and zone is not None and "Z" not in zone:
+        raise ParamError("zone.Z", "an inside diameter with a zone leaves the bore via zone.Z")
+    out["zone"] = zone
+
+
+def _zone(zone: Any) -> dict[str, float | None] | None:
+    if zone is None:
+        return None
+    if not isinstance(zone, Mapping):
+        raise ParamError("zone", "zone must be an object {\"Z\": _SZA, \"X\": _SZO}")
+    extra = [k for k in zone if k not in ("Z", "X")]
+    z = {k: _number(zone, k, field_name=f"zone.{k}") for k in ("Z", "X") if k in zone}
+    if extra:
+        raise ParamError(f"zone.{extra[0]}", "zone has the keys Z and X only")
+    return z
 
 
 # --- preparing the cycle call -------------------------------------------------------------------
@@ -332,71 +361,130 @@ def _tol(p: dict[str, Any], name: str) -> Any:      # a number or None (the tole
 def prepare(task: str, params: dict[str, Any], ctx: LatheContext) -> LathePrep:
     """The cycle call of a validated task (turning.md §10.2 -> turning §1–turning §6 parameters) and the context
     with the task's channel bits: compensation -> _CHBIT[3], keep_mean -> _CHBIT[4],
-    use_ball_diameter -> _CHBIT[7]; a groove given by value becomes _KB record 1 (``_CALNUM`` 1)."""
-    p = params
+    use_ball_diameter -> _CHBIT[7]; a groove given by value becomes _KB record 1 (``_CALNUM`` 1).
+    The call is the task's entry's in ``LATHE_TASK_RULES``."""
+    common = {"prnum": params["probe"], "fa": params["measuring_path"], "vms": params["feed"],
+              "nmsp": params["measurements"]}
+    return LATHE_TASK_RULES[task].call(task, params, ctx, common)
+
+
+def _probe_tolerances(p: dict[str, Any], common: dict[str, Any]) -> dict[str, Any]:
+    return {**common, "tzl": _tol(p, "zero_range"), "tsa": _tol(p, "safe_area")}
+
+
+def _toolprobe_call(task: str, p: dict[str, Any], ctx: LatheContext, common: dict[str, Any]) -> LathePrep:
+    """CYCLE982 calibrating the tool probe (turning §1)."""
+    wp = 10 if p["reference"] == "workpiece" else 0
+    inc = p["incremental"]
+    call = Cycle982(mvar=wp + (100000 if inc else 0), ma=AXIS_MA[p["axis"]],
+                    md=(0 if p.get("direction") == "+" else 1) if inc else None, **_probe_tolerances(p, common))
+    return LathePrep(task, p, call, ctx)
+
+
+def _tool_call(task: str, p: dict[str, Any], ctx: LatheContext, common: dict[str, Any], *,
+               auto: bool = False) -> LathePrep:
+    """CYCLE982 measuring a tool (turning §2), automatically (``auto``: _MVAR units digit 2)."""
+    wp = 10 if p["reference"] == "workpiece" else 0
     chbit = dict(ctx.chbit)
-    call: Cycle982 | Cycle973 | WorkpieceCall
-    common = {"prnum": p["probe"], "fa": p["measuring_path"], "vms": p["feed"], "nmsp": p["measurements"]}
-    if task.startswith("lathe.tool"):
-        wp = 10 if p["reference"] == "workpiece" else 0
-        common.update(tzl=_tol(p, "zero_range"), tsa=_tol(p, "safe_area"))
-        if task == "lathe.toolprobe.calibrate":
-            inc = p["incremental"]
-            call = Cycle982(mvar=wp + (100000 if inc else 0), ma=AXIS_MA[p["axis"]],
-                            md=(0 if p.get("direction") == "+" else 1) if inc else None, **common)
-            return LathePrep(task, p, call, ctx)
-        chbit[3] = 1 if p["compensation"] == "wear" else 0
-        d4 = {"length": 0, "radius": 1, "length_radius": 2}[p["quantity"]]
-        mvar = (2 if task == "lathe.tool.auto" else 1) + wp + 100 * int(p["reversal"]) + 1000 * d4 \
-            + 10000 * int(p["position"] == "radial") + 100000 * int(p.get("incremental", False))
-        inc = p.get("incremental", False)
-        call = Cycle982(mvar=mvar, ma=AXIS_MA.get(p.get("axis", "Z"), 1), md=(0 if p.get("direction") == "+" else 1)
-                        if inc else None, tdif=_tol(p, "dim_difference"), evnum=int(_tol(p, "evnum")),
-                        sta1=p["start_angle"], cora=p["correction_angle"], **common)
-        return LathePrep(task, p, call, replace(ctx, chbit=chbit))
-    if task.startswith("lathe.probe"):
-        common.update(tzl=_tol(p, "zero_range"), tsa=_tol(p, "safe_area"))
-        if task == "lathe.probe.surface":
-            call = Cycle973(mvar=0, ma=AXIS_MA[p["axis"]], md=0 if p["direction"] == "+" else 1,
-                            setval=p["setpoint"], **common)
-            return LathePrep(task, p, call, ctx)
-        g = p["groove"]
-        both = p["direction"] == "both"
-        mvar = 13 + 100 * int(p["ball_diameter"]) + 1000 * (2 if both else 1) + 10000 * int(p["skew"])
-        md = 0 if p["direction"] == "+" else 1
-        if "number" in g:
-            calnum, run_ctx = g["number"], ctx
-        else:
-            kb = (g.get("x_plus", 0.0), g.get("x_minus", 0.0), g.get("bottom_z", 0.0), g.get("z_plus", 0.0),
-                  g.get("z_minus", 0.0), g.get("top_x", 0.0), g.get("bottom_x", 0.0))
-            calnum, run_ctx = 1, replace(ctx, kb=(kb,))
-        call = Cycle973(mvar=mvar, ma=AXIS_MA[p["axis"]], md=md, calnum=calnum, **common)
-        return LathePrep(task, p, call, run_ctx)
+    chbit[3] = 1 if p["compensation"] == "wear" else 0
+    d4 = {"length": 0, "radius": 1, "length_radius": 2}[p["quantity"]]
+    inc = p.get("incremental", False)
+    mvar = (2 if auto else 1) + wp + 100 * int(p["reversal"]) + 1000 * d4 \
+        + 10000 * int(p["position"] == "radial") + 100000 * int(inc)
+    call = Cycle982(mvar=mvar, ma=AXIS_MA.get(p.get("axis", "Z"), 1), md=(0 if p.get("direction") == "+" else 1)
+                    if inc else None, tdif=_tol(p, "dim_difference"), evnum=int(_tol(p, "evnum")),
+                    sta1=p["start_angle"], cora=p["correction_angle"], **_probe_tolerances(p, common))
+    return LathePrep(task, p, call, replace(ctx, chbit=chbit))
+
+
+def _surface_call(task: str, p: dict[str, Any], ctx: LatheContext, common: dict[str, Any]) -> LathePrep:
+    """CYCLE973 calibrating the probe on a surface (turning §3)."""
+    call = Cycle973(mvar=0, ma=AXIS_MA[p["axis"]], md=0 if p["direction"] == "+" else 1,
+                    setval=p["setpoint"], **_probe_tolerances(p, common))
+    return LathePrep(task, p, call, ctx)
+
+
+def _groove_call(task: str, p: dict[str, Any], ctx: LatheContext, common: dict[str, Any]) -> LathePrep:
+    """CYCLE973 calibrating the probe in a groove (turning §3): a stored _KB record or the values as record 1."""
+    g = p["groove"]
+    both = p["direction"] == "both"
+    mvar = 13 + 100 * int(p["ball_diameter"]) + 1000 * (2 if both else 1) + 10000 * int(p["skew"])
+    md = 0 if p["direction"] == "+" else 1
+    if "number" in g:
+        calnum, run_ctx = g["number"], ctx
+    else:
+        kb = (g.get("x_plus", 0.0), g.get("x_minus", 0.0), g.get("bottom_z", 0.0), g.get("z_plus", 0.0),
+              g.get("z_minus", 0.0), g.get("top_x", 0.0), g.get("bottom_x", 0.0))
+        calnum, run_ctx = 1, replace(ctx, kb=(kb,))
+    call = Cycle973(mvar=mvar, ma=AXIS_MA[p["axis"]], md=md, calnum=calnum, **_probe_tolerances(p, common))
+    return LathePrep(task, p, call, run_ctx)
+
+
+def _workpiece_target(p: dict[str, Any]) -> tuple[ToolTarget | None, str | None, int]:
+    """(tool target, zero offset, _KNUM) of a workpiece task's ``target``."""
+    t = p["target"]
+    if isinstance(t, str) and t != "measure_only":
+        return None, t, ZO_NAMES[t]
+    if isinstance(t, Mapping):
+        return ToolTarget(t=t["tool"], d=t["edge"], quantity=t["correct"], inverse=t["inverse"],
+                          geometry=t["mode"] == "geometry"), None, 0
+    return None, None, 0
+
+
+def _workpiece_tolerances(p: dict[str, Any], ctx: LatheContext) -> tuple[dict[str, Any], dict[int, int]]:
+    """The tolerance parameters of CYCLE974/994 and the channel bits with keep_mean (_CHBIT[4])."""
     tol = {TOLERANCE_KEYS[k]: _tol(p, k) for k in TOLERANCE_KEYS}
     tol["evnum"] = int(tol["evnum"])
+    chbit = dict(ctx.chbit)
     if "keep_mean" in p["tolerance"]:
         chbit[4] = int(p["tolerance"]["keep_mean"])
-    t = p["target"]
-    target = zero = None
-    knum = 0
-    if isinstance(t, str) and t != "measure_only":
-        zero, knum = t, ZO_NAMES[t]
-    elif isinstance(t, Mapping):
-        target = ToolTarget(t=t["tool"], d=t["edge"], quantity=t["correct"], inverse=t["inverse"],
-                            geometry=t["mode"] == "geometry")
-    if task == "lathe.point":
-        mvar = 100 if zero else (1000 if p["reversal"] else 0)
-        call = WorkpieceCall(cycle=974, mvar=mvar, setval=p["setpoint"], ma=AXIS_MA[p["axis"]], knum=knum,
-                             tnum=target.t if target else 0, sta1=p["start_angle"], **common, **tol)
-    else:
-        chbit[7] = int(p["use_ball_diameter"])
-        zone = p["zone"] or {}
-        mvar = 1 if p["inside"] and p["zone"] else 2
-        call = WorkpieceCall(cycle=994, mvar=mvar, setval=p["setpoint"], ma=AXIS_MA[p["axis"]],
-                             tnum=target.t if target else 0, sza=zone.get("Z", 0.0), szo=zone.get("X", 0.0),
-                             **common, **tol)
+    return tol, chbit
+
+
+def _point_call(task: str, p: dict[str, Any], ctx: LatheContext, common: dict[str, Any]) -> LathePrep:
+    """CYCLE974: one point, into a zero offset, a tool, or measure only (turning §4)."""
+    tol, chbit = _workpiece_tolerances(p, ctx)
+    target, zero, knum = _workpiece_target(p)
+    mvar = 100 if zero else (1000 if p["reversal"] else 0)
+    call = WorkpieceCall(cycle=974, mvar=mvar, setval=p["setpoint"], ma=AXIS_MA[p["axis"]], knum=knum,
+                         tnum=target.t if target else 0, sta1=p["start_angle"], **common, **tol)
     return LathePrep(task, p, call, replace(ctx, chbit=chbit), target=target, zero_offset=zero,
                      info={"inside": p.get("inside")})
+
+
+def _two_point_call(task: str, p: dict[str, Any], ctx: LatheContext, common: dict[str, Any]) -> LathePrep:
+    """CYCLE994: a diameter by two points (turning §5), _CHBIT[7] with use_ball_diameter."""
+    tol, chbit = _workpiece_tolerances(p, ctx)
+    target, zero, _knum = _workpiece_target(p)
+    chbit[7] = int(p["use_ball_diameter"])
+    zone = p["zone"] or {}
+    mvar = 1 if p["inside"] and p["zone"] else 2
+    call = WorkpieceCall(cycle=994, mvar=mvar, setval=p["setpoint"], ma=AXIS_MA[p["axis"]],
+                         tnum=target.t if target else 0, sza=zone.get("Z", 0.0), szo=zone.get("X", 0.0),
+                         **common, **tol)
+    return LathePrep(task, p, call, replace(ctx, chbit=chbit), target=target, zero_offset=zero,
+                     info={"inside": p.get("inside")})
+
+
+@dataclass(frozen=True)
+class LatheTaskRules:
+    """What one lathe task takes (its own params into the normalised ones) and which cycle call it
+    makes of them (turning.md §10.2): the table replaces every branch on the task's name."""
+
+    params: Callable[[Mapping[str, Any], dict[str, Any]], None]
+    call: Callable[[str, dict[str, Any], LatheContext, dict[str, Any]], LathePrep]
+
+
+LATHE_TASK_RULES: dict[str, LatheTaskRules] = {
+    "lathe.toolprobe.calibrate": LatheTaskRules(partial(_tool_params, calibrate=True), _toolprobe_call),
+    "lathe.tool.measure": LatheTaskRules(_tool_params, _tool_call),
+    "lathe.tool.auto": LatheTaskRules(partial(_tool_params, auto=True), partial(_tool_call, auto=True)),
+    "lathe.probe.groove": LatheTaskRules(_groove_params, _groove_call),
+    "lathe.probe.surface": LatheTaskRules(_surface_params, _surface_call),
+    "lathe.point": LatheTaskRules(_point_params, _point_call),
+    "lathe.two_point": LatheTaskRules(_two_point_params, _two_point_call),
+}
+assert tuple(LATHE_TASK_RULES) == LATHE_TASKS
 
 
 # --- running and evaluating ------------------------------------------------------------------------

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 
 import pytest
 from fastapi.testclient import TestClient
@@ -58,12 +59,34 @@ def scenario_file(tmp_path):
     return path
 
 
+@pytest.fixture(scope="session")
+def migrated_sqlite(tmp_path_factory):
+    """An empty SQLite file migrated to the head revision once per session (db.upgrade_to_head,
+    no rows). An app's SQLite database starts as a copy of it, so each app test does not run
+    every migration again; the migrations themselves are tested from an empty file in tests/db."""
+    from sqlalchemy import create_engine
+
+    from db.database import upgrade_to_head
+
+    path = tmp_path_factory.mktemp("migrated") / "hmi.db"
+    engine = create_engine(f"sqlite:///{path}")
+    try:
+        with engine.begin() as connection:
+            upgrade_to_head(connection)
+    finally:
+        engine.dispose()
+    return path
+
+
 @pytest.fixture
-def app(database_target, scenario_file):
+def app(request, database_target, scenario_file):
     # imported here so a broken app never stops the db/engine/sim tests from being collected
     from app.config import Settings
     from app.main import create_app
 
+    if not isinstance(database_target, str):                  # SQLite: start from the migrated copy
+        database_target.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(request.getfixturevalue("migrated_sqlite"), database_target)
     return create_app(Settings(**database_settings(database_target), scenario_path=scenario_file))
 
 

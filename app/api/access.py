@@ -6,6 +6,7 @@ from __future__ import annotations
 from typing import Annotated
 
 from fastapi import APIRouter, Body, Request, Response
+from fastapi.concurrency import run_in_threadpool
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictInt, StrictStr
 
 from app.access.deps import identity_of, needs
@@ -14,6 +15,7 @@ from app.access.identity import TRAINER
 from app.access.levels import describe_level, keyswitch_level
 from app.access.middleware import is_local
 from app.access.service import SESSION_COOKIE, AccessError, AccessService, SignInRefused
+from app.access.throttle import HTTP, Throttled
 from app.errors import ConflictError, HmiError, InvalidInput, NotFoundError
 
 router = APIRouter(tags=["access"])
@@ -73,6 +75,30 @@ def clear_session_cookie(request: Request, response: Response) -> None:
                            samesite="strict", secure=request.url.scheme == "https")
 
 
+def _refused(exc: SignInRefused | Throttled) -> HmiError:
+    error = HmiError(exc.message, code=exc.code)
+    error.status = exc.status if isinstance(exc, SignInRefused) else 429
+    if exc.retry_after_s is not None:
+        error.headers["Retry-After"] = str(exc.retry_after_s)
+    return error
+
+
+def _source(request: Request) -> tuple[str, str]:
+    client = request.scope.get("client")
+    return HTTP, client[0] if client else ""
+
+
+def refuse_at_once(request: Request) -> None:
+    """429 before any work when this computer must wait or every password check is taken: on the
+    event loop, so a flood of refused sign-ins takes no worker thread from the machine's calls."""
+    gate = access_of(request).gate
+    try:
+        gate.check_source(_source(request))
+        gate.check_room()
+    except Throttled as exc:
+        raise _refused(exc) from None
+
+
 def sign_in(request: Request, user: str | None, password: str | None, panel: bool = False):
     """(session secret, identity); HmiError with the status to answer."""
     access = access_of(request)
@@ -84,19 +110,25 @@ def sign_in(request: Request, user: str | None, password: str | None, panel: boo
             raise error
         return access.sign_in_panel()
     try:
-        return access.sign_in(user or "", password or "")
+        return access.sign_in(user or "", password or "", _source(request))
     except SignInRefused as exc:
-        error = HmiError(exc.message, code=exc.code)
-        error.status = exc.status
-        raise error from None
+        raise _refused(exc) from None
 
 
-@router.post("/session", name="api_session_create")
-def create_session(request: Request, response: Response, body: SignInBody) -> dict:
+@router.post("/session", name="api_session_create", responses={429: {"description": "too many failed "
+             "sign-ins from this computer, or every password check is taken: try again after Retry-After"}})
+async def create_session(request: Request, response: Response, body: SignInBody) -> dict:
     """Sign in: sets the session cookie (HttpOnly, SameSite=Strict, for ``session_hours``); the answer
-    holds the CSRF token a browser script sends as ``X-CSRFToken``."""
+    holds the CSRF token a browser script sends as ``X-CSRFToken``. Password checks are bounded
+    (docs/hardening.md): over the bound, 429 at once with ``Retry-After``."""
     if not body.panel and (body.user is None or body.password is None):
         raise InvalidInput("user and password are required (or panel: true)", field="user")
+    if not body.panel:
+        refuse_at_once(request)
+    return await run_in_threadpool(_signed_in, request, response, body)
+
+
+def _signed_in(request: Request, response: Response, body: SignInBody) -> dict:
     secret, identity = sign_in(request, body.user, body.password, body.panel)
     set_session_cookie(request, response, secret, access_of(request).session_seconds)
     token = request.scope.get("csrftoken")

@@ -10,7 +10,7 @@ from sse_starlette import EventSourceResponse
 
 from app.access.deps import needs
 from app.deps import MachineDep, WorkflowDep
-from app.services.live import LiveFeed
+from app.services.live import LiveHub
 
 router = APIRouter(tags=["live"])
 
@@ -25,15 +25,11 @@ async def events(request: Request, machine: MachineDep, workflow: WorkflowDep,
                                                   description="the browser tab: its held jog stops when "
                                                               "this feed drops (issue 24 §6)")] = None):
     """Server-sent events: ``machine`` (the ``GET /api/machine`` body) 20 times a second while the
-    machine moves, on every change and at least 4 times a second at rest; ``session`` (the
+    machine moves, on every change and at least 4 times a second at rest (the same state again:
+    the heartbeat); ``session`` (the
     ``GET /api/measure/{id}`` body, ``{"id": null}`` without a session) on every change, e.g. the
     progress of a running NC Start (point, pass, step)."""
-    def session() -> dict | None:
-        current = workflow.session
-        return None if current is None else current.to_api()
-
-    feed = LiveFeed(machine.status, session, machine.changes)
-    stream = feed.events(limit, request.is_disconnected)
+    stream = _hub(request, machine, workflow).events(limit)
     if tab is not None:
         machine.tab_back(tab)
         stream = _held_jog_stops_with(stream, machine, tab)
@@ -41,7 +37,21 @@ async def events(request: Request, machine: MachineDep, workflow: WorkflowDep,
                                headers={"Cache-Control": "no-store", "X-Accel-Buffering": "no"})
 
 
-async def _held_jog_stops_with(stream: AsyncIterator[dict], machine, tab: str) -> AsyncIterator[dict]:
+def _hub(request: Request, machine, workflow) -> LiveHub:
+    """The HMI's one live feed (made on first use; a scenario load keeps both services)."""
+    hub = getattr(request.app.state, "live_hub", None)
+    if hub is None or hub.sources != (machine, workflow):
+        def session() -> dict | None:
+            current = workflow.session
+            return None if current is None else current.to_api()
+
+        hub = LiveHub(machine.snapshot, session, machine.changes)
+        hub.sources = (machine, workflow)
+        request.app.state.live_hub = hub
+    return hub
+
+
+async def _held_jog_stops_with(stream: AsyncIterator[bytes], machine, tab: str) -> AsyncIterator[bytes]:
     """The feed of ``tab``; when it ends (the browser died, the tab closed, the network went) the
     jog that tab holds stops at once, not only when its renewals run out."""
     try:

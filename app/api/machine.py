@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from fastapi import APIRouter, Body, Query, Request
+from fastapi import APIRouter, Body, Query, Request, Response
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, StrictInt, StrictStr
 
 from app.access.deps import needs
@@ -75,9 +75,10 @@ def health() -> dict:
     return {"status": "ok"}
 
 
-@router.get("/machine", name="api_machine")
-def machine_state(machine: MachineDep) -> dict:
-    return machine.status()
+@router.get("/machine", name="api_machine", response_model=dict)
+def machine_state(machine: MachineDep) -> Response:
+    # the snapshot's bytes, encoded once per state version (issue 30 item 2)
+    return Response(machine.snapshot().json, media_type="application/json")
 
 
 @router.post("/machine/jog", name="api_machine_jog", dependencies=[needs("jog")])

@@ -72,6 +72,7 @@ class Contact:
         self._rng = np.random.default_rng(scenario.seed)     # the latch noise
         self._table_angle = float(table_angle)
         self._scene = build_scene(scenario, table_angle=self._table_angle)
+        self._touching_last: tuple[tuple, tuple[bool, bool]] | None = None
 
     @property
     def scene(self) -> Scene:
@@ -88,6 +89,7 @@ class Contact:
             return False
         self._table_angle = table_angle
         self._scene = build_scene(self._scenario, table_angle=table_angle)
+        self._touching_last = None
         return True
 
     # --- the first event on a path ---------------------------------------------------------
@@ -159,7 +161,17 @@ class Contact:
     def touching(self, position: np.ndarray, tool: int | None, spindle_angle: float) -> tuple[bool, bool]:
         """(workpiece probe, tool probe): does a solid deflect it at the axes ``position`` now?
         The ball deflects the workpiece probe against any solid and the tool probe against its
-        disc; a cutter deflects the tool probe (design.md §10.4)."""
+        disc; a cutter deflects the tool probe (design.md §10.4). Remembered for the last pose:
+        every status read asks, and at rest the answer cannot change (issue 30)."""
+        key = (np.asarray(position, dtype=float).tobytes(), tool, float(spindle_angle))
+        last = self._touching_last
+        if last is not None and last[0] == key:
+            return last[1]
+        answer = self._touching(position, tool, spindle_angle)
+        self._touching_last = (key, answer)
+        return answer
+
+    def _touching(self, position: np.ndarray, tool: int | None, spindle_angle: float) -> tuple[bool, bool]:
         if tool is None:
             return False, False
         tp = self._scenario.tool_probe

@@ -216,6 +216,9 @@ class SwivelHead(Protocol):
 
     def has_swivel(self) -> bool: ...
 
+    def head_axes(self) -> tuple[str, ...]:
+        """The head's rotary axes in their order (ValueError without a swivel head)."""
+
     def retract_tool_axis(self, distance: float | None = None) -> MoveResult: ...
 
     def swivel_to_wcs(self, wcs2bcs_rotation, infeed=(0.0, 0.0, 1.0)) -> MoveResult: ...
@@ -231,6 +234,50 @@ class KinematicData(Protocol):
 
     def write_kinematic_data(self, lines: dict) -> None:
         """Replace the lines of the axes given (others keep theirs); ValueError names a bad axis."""
+
+
+@runtime_checkable
+class Lathe(Protocol):
+    """Optional: a lathe (turning.md §10.2): X in MCS is a radius, with DIAMON the control shows and
+    takes it as a diameter; the tools sit in a turret and their lengths L1/L2 come from the NC's
+    tool data; SPOS turns the clamped part. The HMI asks ``isinstance(machine, Lathe)``."""
+
+    @property
+    def diameter_programming(self) -> bool:
+        """DIAMON: X shown and programmed as a diameter."""
+
+    @property
+    def spos_capable(self) -> bool:
+        """The main spindle can be positioned (SPOS); else the cycles refuse what needs it."""
+
+
+@runtime_checkable
+class ProtectedSpace(Protocol):
+    """Optional: a control with a commissioned model of its work space (the start guard, issue 24 §1)."""
+
+    def protection_model(self) -> dict:
+        """The solids and axis limits the control protects (plain data, MCS)."""
+
+
+@runtime_checkable
+class FrameCapacity(Protocol):
+    """Optional: a control that cannot hold every frame the HMI offers (LinuxCNC: no tilted G54)."""
+
+    def holds(self, name: str, frame: dict) -> Alarm | None:
+        """None when the NC can hold ``frame`` as ``name``; else the alarm it refuses it with."""
+
+
+@runtime_checkable
+class OwnConfiguration(Protocol):
+    """Optional: a control started on the machine's own configuration (LinuxCNC ``--linuxcnc-ini``):
+    its INI file and the tool table it holds, which the HMI takes over at its start."""
+
+    @property
+    def own_ini(self):
+        """The machine's own INI file (a path), None on a generated configuration."""
+
+    def nc_tool_table(self) -> dict[int, dict]:
+        """{T: {"length", "radius"}} as the control holds them; {} on a generated configuration."""
 
 
 @runtime_checkable

@@ -164,6 +164,9 @@ class SimulatedMachine(SimulatedControl):
     def has_swivel(self) -> bool:
         return self._kinematics.has_swivel()
 
+    def head_axes(self) -> tuple[str, ...]:
+        return self._kinematics.head_axes()
+
     def swivel_to(self, angles: dict[str, float]) -> MoveResult:
         """Turn the head axes to ``angles`` (deg), collision-checked at samples, rapid."""
         head_axes = self._kinematics.head_axes()

@@ -27,7 +27,7 @@ from . import security
 from .alarms import AlarmEvents
 from .results import ResultManagement
 from .space import JogMeasureSpace
-from .users import HmiUserManager
+from .users import HmiUserManager, count_sign_ins_per_client
 from .values import alarm_keys, machine_values, measurement_value, offset_values
 from .writes import GuardedAttributeService
 
@@ -142,6 +142,7 @@ class OpcUaEndpoint:
         updates.results = ResultManagement(server, idx, self._services)      # OPC 40001-101 (design.md §10.3)
         await updates.results.setup(space.node(()))
         iserver = server.iserver
+        count_sign_ins_per_client(iserver)
         iserver.attribute_service = GuardedAttributeService(
             iserver.aspace, self._services, self._access, space.writable, updates.show_offset)
         await server.start()

@@ -23,6 +23,7 @@ With a swivel head turned out of +Z the length goes along the machine's actual t
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import threading
@@ -40,11 +41,14 @@ from app.machine.lathe_scenario import LatheScenario
 from app.machine.protocol import (
     ActiveFrame,
     Alarm,
+    FrameCapacity,
+    Lathe,
     Machine,
     MachineAlarm,
     MachineBusy,
     MachineStatus,
     MoveResult,
+    OwnConfiguration,
     ProbeState,
     SimulatorControl,
     SwivelHead,
@@ -55,7 +59,7 @@ from db import Database
 from engine.alarms import all_alarms
 from engine.alarms import by_number as alarm_by_number
 from engine.coords import GEOMETRY_AXES, LatheToolTip, ToolTip, head_shift_of, length_axis
-from engine.frames import G500, Frame, FrameChain, chain_of, is_basic
+from engine.frames import G500, SETFRAME, Frame, FrameChain, basic_frame_names, chain_of, is_basic
 from engine.planes import plane as plane_by_name
 
 from . import lathe_data
@@ -81,6 +85,22 @@ def alarm_dict(alarm: Alarm) -> dict:
         definition = next((a for a in all_alarms() if a.number == alarm.code and a.resettable == alarm.resettable),
                           definition)
     return {"code": alarm.code, "text": alarm.text, "remedy": definition.remedy if definition else ""}
+
+
+class StatusSnapshot:
+    """One state version of ``MachineService.status()``: the body and its JSON bytes (encoded once,
+    on first use, as FastAPI's JSONResponse encodes). ``key``/``machine``/``chain``: what it was made of."""
+
+    def __init__(self, key: tuple, machine: Machine, chain: FrameChain, body: dict, version: int):
+        self.key, self.machine, self.chain, self.body, self.version = key, machine, chain, body, version
+        self._json: bytes | None = None
+
+    @property
+    def json(self) -> bytes:
+        if self._json is None:
+            self._json = json.dumps(self.body, ensure_ascii=False, allow_nan=False, indent=None,
+                                    separators=(",", ":")).encode("utf-8")
+        return self._json
 
 
 class MachineService:
@@ -110,6 +130,7 @@ class MachineService:
         self.mode_source: Callable[[], str | None] | None = None   # the NC channel's mode (MDA/AUTO)
         # what runs and locks the rest ({"mode", "program"}: a program, a JOG measurement) or None
         self.lock_source: Callable[[], dict | None] | None = None
+        self._snapshot: StatusSnapshot | None = None
         self.changes = ChangeSignal()        # a change without motion (a probe deflected by hand): the live feed
         with db.unit(readonly=True) as unit:
             active = unit.get_state(STATE_ACTIVE_OFFSET, G500)
@@ -117,7 +138,11 @@ class MachineService:
         self._seed_data(reset=False)
         self._take_nc_tools()
         self._push_nc_data()
-        self.activate(active if self._is_settable(active) else G500)
+        try:
+            self.activate(active if self._is_settable(active) else G500)
+        except AlarmError:                     # a stored frame the NC cannot hold: no offset, alarm shown
+            with contextlib.suppress(AlarmError):
+                self.activate(G500)
         self._restore_tool(tool)
 
     # --- read-only views ----------------------------------------------------------------
@@ -145,33 +170,77 @@ class MachineService:
     def chain(self) -> FrameChain:
         return self._chain
 
+    # --- what the machine is (its capabilities, protocol.py; asked here once each) ----------------
     @property
     def is_lathe(self) -> bool:
         """The machine is a lathe (turning.md §10.2): X radius, DIAMON, the lathe tasks."""
-        return getattr(self._machine, "kind", "mill") == "lathe"
+        return isinstance(self._machine, Lathe)
 
     @property
     def diameter_programming(self) -> bool:
-        return self.is_lathe and bool(getattr(self._machine, "diameter_programming", False))
+        machine = self._machine
+        return isinstance(machine, Lathe) and bool(machine.diameter_programming)
+
+    @property
+    def spos_capable(self) -> bool:
+        """SPOS possible: every milling spindle here; a lathe's main spindle as commissioned."""
+        machine = self._machine
+        return not isinstance(machine, Lathe) or bool(machine.spos_capable)
+
+    # --- the machine's commissioning data (the scenario's machine section, design.md §4) ----------
+    def limits(self) -> dict:
+        """The software limits per axis (MCS)."""
+        return self._scenario.limits()
+
+    @property
+    def rapid_feed(self) -> float:
+        """The rapid traverse (mm/min)."""
+        return float(self._scenario.machine.rapid)
+
+    @property
+    def has_tool_probe(self) -> bool:
+        return self._scenario.tool_probe is not None
 
     def plane(self):
         return plane_by_name("G18" if self.is_lathe else self._settings.get().plane)
 
     def status(self) -> dict:
-        """The ``GET /api/machine`` body (design.md §4) plus channel, tool length, program state."""
+        """The ``GET /api/machine`` body (design.md §4) plus channel, tool length, program state.
+        Shared by every caller until the state changes (``snapshot``): read it, never change it."""
+        return self.snapshot().body
+
+    def snapshot(self) -> StatusSnapshot:
+        """The state as one value per state version: built again only when something it is made
+        of changed (the machine's status, mode, lock, offset, chain, plane, feed hold), so that
+        polls and the live feed cost no frame arithmetic and no encoding at rest (issue 30)."""
         st = self._machine.status()
         self._see_alarms(st)
         settings = self._settings.get()
+        plane, units = settings.plane, settings.units
+        mode = (self.mode_source() if self.mode_source else None) or st.mode
+        lock = self.lock_source() if self.lock_source else None
+        machine, chain = self._machine, self._chain
+        key = (st, mode, lock, self._active_offset, plane, units, self._held_override is not None, self.has_swivel(),
+               self.diameter_programming, self._scenario)
+        last = self._snapshot
+        if last is not None and last.machine is machine and last.chain is chain and last.key == key:
+            return last
+        snapshot = StatusSnapshot(key, machine, chain, self._status_body(st, plane, units, mode, lock),
+                                  (last.version + 1) if last is not None else 1)
+        self._snapshot = snapshot
+        return snapshot
+
+    def _status_body(self, st: MachineStatus, plane: str, units: str, mode: str, lock: dict | None) -> dict:
         alarms = [alarm_dict(a) for a in st.alarms]
         program_state = "active" if st.busy else ("interrupted" if alarms else "reset")
         return {
-            "mode": (self.mode_source() if self.mode_source else None) or st.mode,
+            "mode": mode,
             "channel": CHANNEL,
             "mcs": {a: float(v) for a, v in st.mcs.items()},
-            "wcs": self.wcs_from_mcs(st.mcs, st.tool_length),
+            "wcs": self.wcs_from_mcs(st.mcs, st.tool_length, st),
             "active_offset": self._active_offset,
-            "plane": settings.plane,
-            "units": settings.units,        # the screens' units (design.md §9.9): the live feed carries a change
+            "plane": plane,
+            "units": units,                 # the screens' units (design.md §9.9): the live feed carries a change
             "tool": st.tool,
             "tool_length": float(st.tool_length),
             "feed_override": float(st.feed_override),
@@ -179,7 +248,7 @@ class MachineService:
             "alarms": alarms,
             "busy": bool(st.busy),
             "feed_hold": self._held_override is not None,
-            "lock": self.lock_source() if self.lock_source else None,
+            "lock": lock,
             "program_state": program_state,
             "tool_axis": [float(v) for v in getattr(st, "tool_axis", (0.0, 0.0, 1.0))],
             "head_shift": [float(v) for v in head_shift_of(getattr(st, "head_shift", None))],
@@ -233,7 +302,8 @@ class MachineService:
         return self._probe_status(self._machine.status())
 
     def _linuxcnc_ini(self) -> str | None:
-        own = getattr(self._machine, "own_ini", None)
+        machine = self._machine
+        own = machine.own_ini if isinstance(machine, OwnConfiguration) else None
         return str(own) if own is not None else None
 
     def _probe_status(self, st: MachineStatus) -> dict:
@@ -272,6 +342,11 @@ class MachineService:
         head = self._swivel_head()
         return head is not None and bool(head.has_swivel())
 
+    def head_axes(self) -> tuple[str, ...]:
+        """The swivel head's axes (A/B/C), in their order; () without a swivel head."""
+        head = self._swivel_head()
+        return tuple(head.head_axes()) if head is not None and head.has_swivel() else ()
+
     def retract_tool_axis(self, distance: float | None = None) -> dict:
         """Retract up along the tool axis (to the limits by default) before a swivel (jog-measuring §11 Q9)."""
         if distance is not None:
@@ -291,9 +366,10 @@ class MachineService:
         return self._run(lambda: head.swivel_to_wcs(rotation, infeed))
 
     # --- coordinates ----------------------------------------------------------------------
-    def _tip(self, tool_length: float | None) -> ToolTip | LatheToolTip:
+    def _tip(self, tool_length: float | None, st: MachineStatus | None = None) -> ToolTip | LatheToolTip:
         """Tool tip <-> axis positions in the active chain (``engine.coords``)."""
-        st = self._machine.status()
+        if st is None:
+            st = self._machine.status()
         if self.is_lathe:
             l1, l2 = getattr(st, "tool_lengths", (0.0, 0.0))
             return LatheToolTip(self._chain.wcs2bcs, float(l1), float(l2))
@@ -302,8 +378,9 @@ class MachineService:
         axis = length_axis(getattr(st, "tool_axis", None), self.plane().infeed_unit)
         return ToolTip(self._chain.wcs2bcs, float(tool_length), axis, head_shift_of(getattr(st, "head_shift", None)))
 
-    def wcs_from_mcs(self, mcs: Mapping[str, float], tool_length: float | None = None) -> dict[str, float]:
-        p_wcs = self._tip(tool_length).tip_in_wcs([float(mcs.get(a, 0.0)) for a in GEOMETRY_AXES])
+    def wcs_from_mcs(self, mcs: Mapping[str, float], tool_length: float | None = None,
+                     st: MachineStatus | None = None) -> dict[str, float]:
+        p_wcs = self._tip(tool_length, st).tip_in_wcs([float(mcs.get(a, 0.0)) for a in GEOMETRY_AXES])
         out = {a: float(v) for a, v in zip(GEOMETRY_AXES, p_wcs, strict=True)}
         if self.diameter_programming:
             out["X"] *= 2.0                      # DIAMON: WCS X as a diameter (turning.md §0.3)
@@ -646,6 +723,7 @@ class MachineService:
             raise InvalidInput(f"offset: {name!r} is not a settable zero offset (G500, G54..)", field="offset")
         name = name.upper()
         with self._lock:
+            self._check_chain_holds(name)
             chain = self.build_chain(name)
             wcs2bcs = chain.wcs2bcs
             self._machine.activate_frame(ActiveFrame(name=name, wcs2bcs=wcs2bcs.as_matrix(),
@@ -656,6 +734,19 @@ class MachineService:
                 with self._db.unit() as unit:
                     unit.set_state(STATE_ACTIVE_OFFSET, name)
         return self.status()
+
+    def _check_chain_holds(self, name: str) -> None:
+        """Every frame of the chain ``name`` would make active (the basic frames and ``name``) is one
+        the NC holds (design.md §10.7, issue 34 §5): LinuxCNC holds no rotation about X or Y and no
+        basic frame, so such an activation is refused with the NC's alarm (409, 61321), nothing
+        shown as active that the NC does not move by."""
+        if not callable(getattr(self._machine, "holds", None)):
+            return
+        with self._db.unit(readonly=True) as unit:
+            stored = unit.list_offsets()
+        names = [n for n in (SETFRAME, *basic_frame_names(stored)) if n in stored]
+        for frame_name in [*names, *([name] if name != G500 and name in stored else [])]:
+            self.check_holds(frame_name, stored[frame_name])
 
     def refresh_frame(self) -> None:
         """Re-compose the active chain after an offset was written (BASIC_*, or the active WO)."""
@@ -723,8 +814,8 @@ class MachineService:
         """A controller that owns its tool table (LinuxCNC with the machine's own INI,
         ``nc_tool_table()``) gives its lengths and radii to the stored tools at the start; a tool
         whose geometry + wear it holds already keeps the HMI's split."""
-        table = getattr(self._machine, "nc_tool_table", None)
-        held = table() if callable(table) else {}
+        machine = self._machine
+        held = machine.nc_tool_table() if isinstance(machine, OwnConfiguration) else {}
         if not held:
             return
         with self._db.unit() as unit:
@@ -833,10 +924,10 @@ class MachineService:
     def check_holds(self, name: str, frame: Mapping) -> None:
         """Before the db write: a frame this NC cannot hold as ``name`` (LinuxCNC: a tilted G54, a
         basic frame) is refused here, a 409 alarm, so the HMI never stores what the NC lacks."""
-        holds = getattr(self._machine, "holds", None)
-        if not callable(holds):
+        machine = self._machine
+        if not isinstance(machine, FrameCapacity):
             return
-        refused = holds(name, self._nc_frame(frame))
+        refused = machine.holds(name, self._nc_frame(frame))
         if refused is not None:
             self._machine.post_alarm(refused)          # as the NC would show a refused write
             raise AlarmError(refused.code, refused.text)

@@ -150,7 +150,7 @@ class MeasuringEnv:
         machine = self._ms.machine
         return {**copy.deepcopy(records), "tool_lengths": tuple(getattr(st, "tool_lengths", (0.0, 0.0))),
                 "diamon": self._ms.diameter_programming, "has_y": "Y" in tuple(machine.axes),
-                "spos": bool(getattr(machine, "spos_capable", True))}
+                "spos": self._ms.spos_capable}
 
     def measuring_setup(self) -> MeasuringSetup:
         return MeasuringSetup(self._ms.plane(), self._ms.active_offset, tuple(self._db.offset_names()),
@@ -316,6 +316,4 @@ class MeasuringEnv:
         self._ms.refresh_frame()
 
     def post_alarm(self, code: int, text: str) -> None:
-        post = getattr(self._ms.machine, "post_alarm", None)
-        if callable(post):
-            post(Alarm(code, text))
+        self._ms.machine.post_alarm(Alarm(code, text))

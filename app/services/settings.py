@@ -38,6 +38,9 @@ class SettingsService:
 
     def get(self) -> GudSettings:
         """Stored values over the defaults; unknown or stale stored keys are ignored."""
+        cached = self._cached                   # no lock while the write count says it is current
+        if cached is not None and cached[0] == self._db.generation:
+            return cached[1]
         with self._lock:
             return self.get_unlocked()
 

@@ -17,8 +17,10 @@ from markupsafe import Markup
 from app.errors import InvalidInput, NotFoundError
 from app.i18n import N_, gettext
 from app.web import units
+from app.workflow.tasks import task_spec
 from engine.plan_workpiece import corner_direction
 from engine.planes import Plane
+from engine.tasks import Family
 
 W, H = 240, 150
 END = ' text-anchor="end"'
@@ -158,7 +160,7 @@ def _corner(task: str, p: dict, plane: Plane) -> Picture:
 def _round(task: str, plane: Plane) -> Picture:
     """Holes and spigots: one (4 touches, the probe in the middle or above) or 2-4 centres."""
     pic = Picture(plane)
-    spigot = task.startswith("spigot")
+    spigot = task_spec(task).family == Family.SPIGOT
     count = int(task.split(".")[1]) if task.split(".")[1].isdigit() else 1
     if count == 1:
         pic.add(f'<rect class="help-part" x="40" y="15" width="160" height="120"/>'
@@ -197,7 +199,7 @@ def _round(task: str, plane: Plane) -> Picture:
 
 def _rect(task: str, plane: Plane) -> Picture:
     pic = Picture(plane)
-    spigot = task.startswith("spigot")
+    spigot = task_spec(task).family == Family.SPIGOT
     pic.add('<rect class="help-part" x="30" y="15" width="180" height="120"/>')
     pic.add(f'<rect class="{"help-boss" if spigot else "help-hole"}" x="70" y="45" width="100" height="60"/>')
     sign = "-" if spigot else "+"

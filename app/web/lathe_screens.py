@@ -141,7 +141,7 @@ def lathe_svgs(env, spec, params: dict | None, answer: dict | None) -> list:
     """The real set-up with the planned path of the next NC Start (never breaks the screen)."""
     try:
         scene = env.machine.scene_geometry()
-        limits = env.machine.scenario.limits()
+        limits = env.machine.limits()
     except EXPECTED:
         return []
     except Exception:

@@ -121,11 +121,11 @@ def _context(request: Request) -> dict:
     services = request.app.state.services
     scene = trainer.visible_scene(services)
     if scene.get("kind") == "lathe":                       # one view, X up and Z right (turning.md §0.1)
-        return {"lathe_svg": Markup(lathe_svg(scene, services.machine.scenario.limits())),
+        return {"lathe_svg": Markup(lathe_svg(scene, services.machine.limits())),
                 "tip": scene.get("probe", {}).get("tip"), "lathe": True, "hidden": scene["hidden"],
                 "spindle_angle": scene.get("spindle_angle"), "views": None}
     status = services.machine.status()
-    return {"views": build_views(scene, services.machine.scenario.limits(), status["mcs"]["Z"]),
+    return {"views": build_views(scene, services.machine.limits(), status["mcs"]["Z"]),
             "tip": scene.get("probe", {}).get("tip"), "hidden": scene["hidden"]}
 
 

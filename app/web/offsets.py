@@ -10,9 +10,11 @@ from fastapi import APIRouter, Form, Request
 from app.access.deps import needs
 from app.deps import MachineDep, OffsetsDep
 from app.errors import ConflictError, HmiError
-from app.i18n import N_
+from app.i18n import N_, gettext
+from app.services.offsets import same_values
 
 from . import units
+from .audit_text import audit_rows, changes
 from .templating import render_block, render_screen
 
 router = APIRouter()
@@ -48,47 +50,23 @@ def offsets_screen(request: Request, offsets: OffsetsDep, machine: MachineDep):
                                                    "active": machine.active_offset})
 
 
-def changes(before, after, prefix: str = "") -> list[str]:
-    """"trans.X: 0.000 → 12.500" for every value that differs (any kind of audited data)."""
-    if isinstance(before, dict) or isinstance(after, dict):
-        before, after = before if isinstance(before, dict) else {}, after if isinstance(after, dict) else {}
-        out = []
-        for key in list(dict.fromkeys([*before, *after])):
-            out += changes(before.get(key), after.get(key), f"{prefix}{key}.")
-        return out
-    if before == after:
-        return []
-    return [f"{prefix.rstrip('.')}: {_text(before)} → {_text(after)}"]
-
-
-def _text(value) -> str:
-    if value is None:
-        return "–"
-    if isinstance(value, float):
-        return f"{value:.4f}".rstrip("0").rstrip(".") if value != int(value) else f"{value:.3f}"
-    return str(value)
-
-
-def who_text(entry: dict) -> str:
-    who = entry.get("who") or "–"
-    return f"{who} (level {entry['level']})" if entry.get("level") is not None else who
-
-
-def audit_rows(entries: list[dict]) -> list[dict]:
-    return [{**e, "changes": changes(e.get("before"), e.get("after")) or ["(no change)"], "who_text": who_text(e)}
-            for e in entries]
+def _gud(request: Request):
+    return request.app.state.services.settings.get()
 
 
 @router.get("/offsets/audit", name="offsets_audit_screen")
 def audit_screen(request: Request, offsets: OffsetsDep):
-    return render_screen(request, "audit.html", {"screen": "offsets", "entries": audit_rows(offsets.audit(50))})
+    return render_screen(request, "audit.html", {"screen": "offsets",
+                                                 "entries": audit_rows(offsets.audit(50), _gud(request))})
 
 
-def _history(request: Request, offsets, name: str, message: str = "", level: str = "info", conflict=None):
+def _history(request: Request, offsets, name: str, message: str = "", level: str = "info", conflict=None,
+             asking: dict | None = None):
     offsets.get(name)                      # 404 for an unknown offset
     return render_screen(request, "offset_history.html", {
-        "screen": "offsets", "name": name, "entries": audit_rows(offsets.audit(100, name, "offset")),
-        "current": offsets.get(name), "form_message": message, "level": level, "conflict": conflict})
+        "screen": "offsets", "name": name, "entries": audit_rows(offsets.audit(100, name, "offset"), _gud(request)),
+        "current": offsets.get(name), "form_message": message, "level": level, "conflict": conflict,
+        "asking": asking})
 
 
 @router.get("/offsets/{name}/history", name="offsets_history_screen")
@@ -97,19 +75,32 @@ def history_screen(request: Request, name: str, offsets: OffsetsDep):
     return _history(request, offsets, name)
 
 
+def _question(request: Request, offsets, entry: dict) -> dict:
+    """What Restore of ``entry`` would write (current value → value before the change) and whether
+    the offset changed since (then Restore also undoes the later changes)."""
+    current = offsets.get(entry["offset"])
+    return {"id": entry["id"], "offset": entry["offset"],
+            "writes": changes("offset", current, entry["before"], _gud(request)),
+            "changed_since": not same_values(current, entry["after"])}
+
+
 @router.post("/offsets/audit/{audit_id}/restore", name="offsets_restore", dependencies=[needs("offsets")])
-def restore(request: Request, audit_id: int, offsets: OffsetsDep, force: Annotated[str, Form()] = ""):
-    """Restore: ``POST /api/audit/{id}/undo`` from the History view; a change made since is named and
-    needs "Restore anyway"."""
+def restore(request: Request, audit_id: int, offsets: OffsetsDep, force: Annotated[str, Form()] = "",
+            confirm: Annotated[str, Form()] = ""):
+    """Restore: first the question (what it writes, whether the offset changed since); confirmed,
+    ``POST /api/audit/{id}/undo`` from the History view; a change made since needs "Restore anyway"."""
     entry = offsets.audit_entry(audit_id)
     if entry["kind"] != "offset":
         raise HmiError(f"change #{audit_id} is not a zero-offset change", code="not_undoable")
+    if confirm != "1":
+        return _history(request, offsets, entry["offset"], asking=_question(request, offsets, entry))
     try:
         done = offsets.restore(entry, force=force == "1")
     except ConflictError as exc:
         return _history(request, offsets, entry["offset"], exc.message, "error", conflict=audit_id)
     return _history(request, offsets, entry["offset"],
-                    f"{entry['offset']} restored to its value before change #{audit_id} (change #{done['audit_id']})")
+                    gettext("%(name)s restored to its value before change #%(id)s (change #%(new)s)",
+                            name=entry["offset"], id=audit_id, new=done["audit_id"]))
 
 
 @router.post("/offsets/{name}/activate", name="offsets_activate", dependencies=[needs("jog")])

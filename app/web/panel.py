@@ -65,7 +65,7 @@ def _jog_feed(request: Request, machine, rapid: str | None = None) -> float | No
     """The tab's jog feed (mm/min): its feed choice, or RAPID times the rapid override; None:
     the machine's own jog feed."""
     panel = PanelState.of(request, machine.axes)
-    traverse = getattr(getattr(machine.scenario, "machine", None), "rapid", 10000.0)
+    traverse = machine.rapid_feed
     feed = panel.jog_feed(traverse, None if rapid is None else rapid == "on")
     return None if feed is None else min(feed, MAX_FEED)
 

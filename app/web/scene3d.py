@@ -51,7 +51,7 @@ def build(services) -> dict:
     nc = trainer.nc_tip(status)
     probe = scene.get("probe") or {}
     offset = np.asarray(probe.get("tip", nc), dtype=float) - np.asarray(nc)
-    limits = {a: list(v) for a, v in machine.scenario.limits().items() if a in AXES}
+    limits = {a: list(v) for a, v in machine.limits().items() if a in AXES}
     session = services.workflow.session if services.workflow is not None else None
     plane = machine.plane()
     return {

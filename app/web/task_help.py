@@ -19,7 +19,8 @@ TEMPLATE = "measure_task.html"
 
 def context(services, task: str, values: dict | None) -> dict:
     """``help_picture`` (SVG figure or None) and ``equipment`` rows for the task's screen."""
-    if task.startswith("lathe."):
+    spec = TASKS.get(task)
+    if spec is not None and spec.lathe:                   # the lathe screens draw their own set-up
         return {"help_picture": None, "equipment": []}
     return {"help_picture": help_pictures.draw(task, values, services.machine.plane()),
             "equipment": help_pictures.equipment_rows(services, task)}

@@ -211,7 +211,7 @@ def csrf_token(request: Request) -> str:
 def base_context(request: Request) -> dict:
     services = request.app.state.services
     machine = services.machine
-    lathe = bool(getattr(machine, "is_lathe", False))
+    lathe = machine.is_lathe
     return {
         "access": AccessView(request),
         "status": machine.status(),

@@ -331,6 +331,13 @@ message(r"Measurement done", N_("Measurement done"))
 message(r"Calculated: WO activated", N_("Calculated: WO activated"))
 message(r"Calculated", N_("Calculated"))
 
+# sign-in (app/access/service.py, app/access/throttle.py)
+message(r"wrong user name or password", N_("wrong user name or password"))
+message(r"too many failed sign-ins from this computer: try again in (?P<seconds>\d+) s",
+        N_("too many failed sign-ins from this computer: try again in %(seconds)s s"))
+message(r"too many sign-ins at once: try again in a moment", N_("too many sign-ins at once: try again in a moment"))
+message(r"password: at least (?P<n>\d+) characters", N_("password: at least %(n)s characters"))
+
 
 def result_value(key: str, value) -> str:
     """A value of those tables: 4 decimals with the language's decimal sign; yes/no translated."""

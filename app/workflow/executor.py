@@ -39,8 +39,8 @@ class StepExecutor:
     def _milling_tip(self) -> ToolTip:
         """tip = A + shift − L·axis with the control's tool axis and head shift as they are now."""
         status = self.machine.status()
-        axis = length_axis(getattr(status, "tool_axis", None), self.infeed_unit)
-        return ToolTip(self.wcs2bcs, float(self.tool_length), axis, head_shift_of(getattr(status, "head_shift", None)))
+        axis = length_axis(status.tool_axis, self.infeed_unit)
+        return ToolTip(self.wcs2bcs, float(self.tool_length), axis, head_shift_of(status.head_shift))
 
     @property
     def tip_conversion(self) -> ToolTip | LatheToolTip:

@@ -9,8 +9,9 @@ evaluation); this module joins it to the app:
   ``effective_diameter``, ``position_deviation``), the reference grooves ``_KB``, DIAMON, Y,
   SPOS capability, and the channel bits the settings give (_CHBIT[5] ev_add, [15] attempts,
   [16] rapid_return, [17] two_stage; _SPEED[1]/[2] position_feed, [3] fast_feed).
-- ``finish_lathe_task``: the finisher of every lathe task: (answer, commit) as the milling
-  finishers. Tool probe calibration writes ``_TP[k]``/``_TPW[k]`` (``tool_probe_update``);
+- ``lathe_finisher(finish_toolprobe | finish_tool | finish_probe | finish_workpiece)``: the
+  finisher of a lathe task, named by its entry in app.workflow.tasks: (answer, commit) as the
+  milling finishers. Tool probe calibration writes ``_TP[k]``/``_TPW[k]`` (``tool_probe_update``);
   tool measuring decides inside the write transaction from the tool data and the EV memory as
   stored then (``ToolOffsetChange``); probe calibration writes ``_WP[k]`` (``probe_update``);
   a 1-point ZO (``lathe.point`` with a WO target) goes through ``engine.correction.correct``
@@ -27,6 +28,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from datetime import UTC, datetime
+from typing import Any
 
 import numpy as np
 from pydantic import ValidationError
@@ -170,26 +172,26 @@ def target_label(target) -> str:
 
 # --- the finisher --------------------------------------------------------------------------------
 
-def finish_lathe_task(session: MeasureSession, ctx: MeasuringContext, points: list) -> tuple[dict, dict]:
-    point = points[0] if points else None
-    if point is None:
-        raise MeasuringError(alarms.PROBE_NOT_SWITCHED, f"{session.task}: no measured point stored")
-    prep = lathe_prep(session, ctx)
-    task = session.task
-    if task == "lathe.toolprobe.calibrate":
-        return _toolprobe(prep, point, ctx)
-    if task in ("lathe.tool.measure", "lathe.tool.auto"):
-        return _tool(prep, point, ctx)
-    if task in ("lathe.probe.groove", "lathe.probe.surface"):
-        return _probe(prep, point, ctx)
-    return _workpiece(session, prep, point, ctx)
+LatheEvaluator = Callable[[MeasureSession, LathePrep, Any, MeasuringContext], tuple[dict, dict]]
+
+
+def lathe_finisher(evaluate: LatheEvaluator) -> Callable[[MeasureSession, MeasuringContext, list],
+                                                         tuple[dict, dict]]:
+    """The finisher of a lathe task (its entry in app.workflow.tasks names its ``evaluate``)."""
+    def finish(session: MeasureSession, ctx: MeasuringContext, points: list) -> tuple[dict, dict]:
+        point = points[0] if points else None
+        if point is None:
+            raise MeasuringError(alarms.PROBE_NOT_SWITCHED, f"{session.task}: no measured point stored")
+        return evaluate(session, lathe_prep(session, ctx), point, ctx)
+
+    return finish
 
 
 def _answer(result: dict, correction: dict | None = None) -> dict:
     return {"result": result, "correction": correction, "activated": False, "setup_support": None}
 
 
-def _toolprobe(prep: LathePrep, point, ctx: MeasuringContext) -> tuple[dict, dict]:
+def finish_toolprobe(session: MeasureSession, prep: LathePrep, point, ctx: MeasuringContext) -> tuple[dict, dict]:
     ev = evaluate_lathe(prep, point)
     r = ev.result
     assert isinstance(r, ToolProbeResult), "a CYCLE982 calibration evaluates to a ToolProbeResult"
@@ -211,7 +213,7 @@ def _toolprobe(prep: LathePrep, point, ctx: MeasuringContext) -> tuple[dict, dic
         {"offset": None, "tool_probe_update": (n, record)}
 
 
-def _tool(prep: LathePrep, point, ctx: MeasuringContext) -> tuple[dict, dict]:
+def finish_tool(session: MeasureSession, prep: LathePrep, point, ctx: MeasuringContext) -> tuple[dict, dict]:
     call = prep.call
     assert isinstance(call, Cycle982), "the lathe tool tasks run CYCLE982"
     tool = ctx.tool or {}
@@ -237,7 +239,7 @@ def _tool(prep: LathePrep, point, ctx: MeasuringContext) -> tuple[dict, dict]:
     return _answer({}), {"offset": None, "tool_offset": ToolOffsetChange(t, compute)}
 
 
-def _probe(prep: LathePrep, point, ctx: MeasuringContext) -> tuple[dict, dict]:
+def finish_probe(session: MeasureSession, prep: LathePrep, point, ctx: MeasuringContext) -> tuple[dict, dict]:
     ev = evaluate_lathe(prep, point)
     r = ev.result
     assert isinstance(r, ProbeCalibrationResult), "a CYCLE973 calibration evaluates to a ProbeCalibrationResult"
@@ -279,7 +281,7 @@ def _tolerance(prep: LathePrep) -> Tolerance:
                      keep_mean=prep.ctx.bit(4))
 
 
-def _workpiece(session: MeasureSession, prep: LathePrep, point, ctx: MeasuringContext) -> tuple[dict, dict]:
+def finish_workpiece(session: MeasureSession, prep: LathePrep, point, ctx: MeasuringContext) -> tuple[dict, dict]:
     call = prep.call
     assert isinstance(call, WorkpieceCall), "lathe.point / lathe.two_point run CYCLE974/994"
     ev_no, mv_no = ev_mv_numbers(call.evnum) if call.evnum else (0, 0)

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from app.errors import ConflictError
+from app.machine.protocol import ProtectedSpace
 from app.workflow.executor import StepExecutor
 from engine import alarms
 from engine.guard import GuardReport, Placement, Segment, check_program, segments_to_api
@@ -30,8 +31,8 @@ class GuardRefused(ConflictError):
 
 
 def protection_data(machine) -> dict | None:
-    provider = getattr(machine, "protection_model", None)
-    return provider() if callable(provider) else None
+    """The control's model of its work space; None: it has none (the path is not checked)."""
+    return machine.protection_model() if isinstance(machine, ProtectedSpace) else None
 
 
 def guarded(spec) -> bool:

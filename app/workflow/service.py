@@ -15,7 +15,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from app.errors import ModeError, WorkflowError
-from app.machine.protocol import MachineAlarm
+from app.machine.protocol import Lathe, MachineAlarm
 from app.workflow import guard, probe_trust
 from app.workflow.context import (
     MEASURE_ONLY,
@@ -147,7 +147,7 @@ class WorkflowService:
 
     def _check_machine_kind(self, spec: TaskSpec) -> None:
         """The lathe tasks need a lathe, the milling tasks a milling machine (turning.md §10.1)."""
-        lathe = getattr(self._env.machine, "kind", "mill") == "lathe"
+        lathe = isinstance(self._env.machine, Lathe)
         if spec.lathe and not lathe:
             raise WorkflowError(409, "not_a_lathe", f"{spec.name} measures on a lathe; this machine is a "
                                 "milling machine", "task")
@@ -172,7 +172,7 @@ class WorkflowService:
         axis = params.get("angle_correction")
         if axis in (None, "rotation", "none"):
             return
-        if axis not in tuple(getattr(self._env.machine, "axes", ())):
+        if axis not in tuple(self._env.machine.axes):
             raise WorkflowError(400, "invalid_param",
                                 f"angle_correction: {axis} is not a rotary axis of this machine",
                                 "angle_correction")

@@ -111,7 +111,7 @@ def screen_model(workflow: WorkflowService, machine, session_id: str) -> dict:
     session, support = _support_of(workflow, session_id)
     last = session.last or {}
     correction = last.get("correction") or {}
-    swivel = bool(getattr(machine, "has_swivel", lambda: False)())
+    swivel = machine.has_swivel()
     hint_axes = rotated_axes(correction.get("before"), correction.get("after"))
     messages = []
     if "realign" in codes_of(support) and not swivel:
@@ -146,7 +146,7 @@ def carry_out(workflow: WorkflowService, machine, session_id: str, choices: Choi
         raise WorkflowError(409, "alarm", f"{alarms[-1].code} {alarms[-1].text}: press Reset first")
     codes = codes_of(support)
     target = support["target"]
-    swivel = bool(getattr(machine, "has_swivel", lambda: False)())
+    swivel = machine.has_swivel()
     actions: list[str] = []
     messages: list[str] = []
     activated = None
@@ -178,7 +178,7 @@ def carry_out(workflow: WorkflowService, machine, session_id: str, choices: Choi
                                     "retract or move clear, then NC Start again)") from None
             actions.append("realign")
             moved = True
-            head = machine.scenario.machine.kinematics.axes
+            head = machine.head_axes()
             angles = ", ".join(f"{a}={status['mcs'][a]:.4f} deg" for a in head)
             messages.append(TEXT_REALIGNED.format(axis=machine.plane().infeed, wo=machine.active_offset,
                                                   angles=angles))

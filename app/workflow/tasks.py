@@ -334,19 +334,24 @@ def _lathe_engine_task(name: str) -> EngineTask:
     return EngineTask(name, Family.LATHE, 1, validate, program)
 
 
-def _lathe(name: str, category: Category, targets: frozenset[Target]) -> LatheTaskSpec:
-    return LatheTaskSpec(_lathe_engine_task(name), category, targets, finish_lathe.finish_lathe_task,
+def _lathe(name: str, category: Category, targets: frozenset[Target],
+           evaluate: finish_lathe.LatheEvaluator) -> LatheTaskSpec:
+    return LatheTaskSpec(_lathe_engine_task(name), category, targets, finish_lathe.lathe_finisher(evaluate),
                          forms.lathe_form)
 
 
 LATHE_SPECS: dict[str, TaskSpec] = {spec.name: spec for spec in [
-    _lathe("lathe.toolprobe.calibrate", Category.TOOL_PROBE_CALIBRATION, frozenset({Target.TOOL_PROBE_RECORD})),
-    _lathe("lathe.tool.measure", Category.TOOL_MEASURING, frozenset({Target.TOOL_DATA})),
-    _lathe("lathe.tool.auto", Category.TOOL_MEASURING, frozenset({Target.TOOL_DATA})),
-    _lathe("lathe.probe.groove", Category.PROBE_CALIBRATION, frozenset({Target.PROBE_RECORD})),
-    _lathe("lathe.probe.surface", Category.PROBE_CALIBRATION, frozenset({Target.PROBE_RECORD})),
-    _lathe("lathe.point", Category.WORKPIECE, frozenset({Target.ZERO_OFFSET, Target.TOOL_OFFSET})),
-    _lathe("lathe.two_point", Category.WORKPIECE, frozenset({Target.TOOL_OFFSET})),
+    _lathe("lathe.toolprobe.calibrate", Category.TOOL_PROBE_CALIBRATION, frozenset({Target.TOOL_PROBE_RECORD}),
+           finish_lathe.finish_toolprobe),
+    _lathe("lathe.tool.measure", Category.TOOL_MEASURING, frozenset({Target.TOOL_DATA}), finish_lathe.finish_tool),
+    _lathe("lathe.tool.auto", Category.TOOL_MEASURING, frozenset({Target.TOOL_DATA}), finish_lathe.finish_tool),
+    _lathe("lathe.probe.groove", Category.PROBE_CALIBRATION, frozenset({Target.PROBE_RECORD}),
+           finish_lathe.finish_probe),
+    _lathe("lathe.probe.surface", Category.PROBE_CALIBRATION, frozenset({Target.PROBE_RECORD}),
+           finish_lathe.finish_probe),
+    _lathe("lathe.point", Category.WORKPIECE, frozenset({Target.ZERO_OFFSET, Target.TOOL_OFFSET}),
+           finish_lathe.finish_workpiece),
+    _lathe("lathe.two_point", Category.WORKPIECE, frozenset({Target.TOOL_OFFSET}), finish_lathe.finish_workpiece),
 ]}
 assert tuple(LATHE_SPECS) == LATHE_TASKS
 TASKS.update(LATHE_SPECS)

@@ -83,14 +83,25 @@ def test_history_view_lists_the_changes_and_restores(client):
     table = client.get("/offsets").text
     assert 'href="/offsets/G55/history"' in table
     history = client.get("/offsets/G55/history").text
-    assert history.count("data-restore=") == 2 and "trans.X: 10.000 → 20.000" in history and "trainer" in history
+    # in the operator's terms (issue 29 item 6): the value's name, the unit, the source
+    assert history.count("data-restore=") == 2 and "<b>translation X</b>: 10.000 mm → 20.000 mm" in history
+    assert "Trainer" in history and ">API<" in history
     token = client.cookies.get("csrftoken")
+    headers = {"Origin": ORIGIN, "X-CSRFToken": token, **HTMX}
     newest = last_id(client, "G55")
     oldest = newest - 1
-    refused = client.post(f"/offsets/audit/{oldest}/restore", headers={"Origin": ORIGIN, "X-CSRFToken": token, **HTMX})
+    # Restore asks first and shows what it writes; nothing is written by the question
+    asked = client.post(f"/offsets/audit/{newest}/restore", headers=headers)
+    assert asked.status_code == 200 and 'id="restore-question"' in asked.text
+    assert "<b>translation X</b>: 20.000 mm → 10.000 mm" in asked.text.split('id="restore-question"')[1]
+    assert client.get("/api/offsets/G55").json()["trans"]["X"] == 20.0
+    # the older change: the offset changed since, the question says so and offers "Restore anyway"
+    asked = client.post(f"/offsets/audit/{oldest}/restore", headers=headers)
+    assert "changed again" in asked.text and "Restore anyway" in asked.text
+    refused = client.post(f"/offsets/audit/{oldest}/restore", headers=headers, data={"confirm": "1"})
     assert refused.status_code == 200 and "Restore anyway" in refused.text
     assert g54(client) is not None and client.get("/api/offsets/G55").json()["trans"]["X"] == 20.0
-    restored = client.post(f"/offsets/audit/{newest}/restore", headers={"Origin": ORIGIN, "X-CSRFToken": token, **HTMX})
+    restored = client.post(f"/offsets/audit/{newest}/restore", headers=headers, data={"confirm": "1"})
     assert restored.status_code == 200 and "restored" in restored.text
     assert client.get("/api/offsets/G55").json()["trans"]["X"] == 10.0
     assert client.get("/api/audit", params={"name": "G55"}).json()[0]["source"] == "undo"
@@ -111,4 +122,5 @@ def test_audit_screen_shows_who_for_every_kind(client):
     client.put("/api/tools/2", json={"length": 10.0})
     client.put("/api/settings", json={"measuring_feed": 250.0})
     page = client.get("/offsets/audit").text
-    assert page.count('class="who-cell">trainer (level 1)') >= 3 and "T2" in page and "measuring_feed" in page
+    assert page.count('class="who-cell">Trainer (level 1)') >= 3 and "T2" in page
+    assert "<b>Measuring feed</b>: 300 mm/min → 250 mm/min" in page      # the setting's name and unit

@@ -134,14 +134,17 @@ TRUE_FORK = {"B": {"point": [0.030, 0.0, -0.020], "direction": [20e-6, 1.0, -35e
              "C": {"point": [-0.025, 0.040, 0.0], "direction": [30e-6, -20e-6, 1.0]}}
 
 
-def test_fork_head_c_axis_measured_with_b_tilted(tmp_path):
+def test_fork_head_c_axis_measured_with_b_tilted_and_the_tilted_setup(tmp_path):
     """B/C head: C runs along the tool axis at the zero position, so B is held at 30° while C turns
-    and the sphere is measured once more with both at 0 (its own place). Checked: B first (C at 0),
-    then C, each against the truth; the points count shows the reference point."""
+    and the sphere is measured once more with both at 0 (its own place). B first (C at 0), then C,
+    each against the truth and optimised; the tilted chain before/after (measured: 21.8 -> 0.4 µm)."""
     sc = kin_scenario(true=TRUE_FORK)
     sc["rotary_axes"] = {"B": {"limits": [-60.0, 60.0]}, "C": {"limits": [-360.0, 360.0]}}
     sc["machine"]["kinematics"] = {"type": "swivel_head", "axes": ["B", "C"], "true": TRUE_FORK}
-    with make_client(tmp_path, sc) as client:
+    sc["workpiece"]["pose"] = {"trans": [300.0, 180.0, -170.0], "rot": [9.0, -7.0, -25.0]}
+    with make_client(tmp_path / "before", sc) as client:
+        _rot, trans_before = pose_errors(chain(client, SwivelOperator(client, sc), sc)["g54"], sc)
+    with make_client(tmp_path / "after", sc) as client:
         for axis, positions in (("B", [-60.0, -30.0, 0.0, 30.0, 60.0]), ("C", [-120.0, -60.0, 0.0, 60.0, 120.0])):
             session = post(client, "/api/measure", {"task": "kinematics.measure", "params": {
                 "sphere": {"center": [float(v) for v in sphere_mcs(sc)], "diameter": SPHERE_D},
@@ -157,3 +160,28 @@ def test_fork_head_c_axis_measured_with_b_tilted(tmp_path):
             assert (result["partner"] == {"B": 30.0}) == (axis == "C")
         status = client.get("/api/machine").json()
         assert status["mcs"]["B"] == 0.0 and status["mcs"]["C"] == 0.0      # back at the zero position
+        _rot, trans_after = pose_errors(chain(client, SwivelOperator(client, sc), sc)["g54"], sc)
+    print(f"fork tilted set-up: before {trans_before * 1000:.2f} um, after {trans_after * 1000:.2f} um")
+    assert trans_after < 0.002 and trans_before > 0.005
+
+
+def test_cycle996_in_a_program_optimises_the_a_axis(tmp_path):
+    """The CYCLE996-like cycle in MDA: _MVAR=1 optimises; _OVR carries the measured line, the
+    control's data hold it afterwards (truth: the scenario's A line)."""
+    sc = kin_scenario(sigma=0.0, true=TRUE_HEAD)
+    c = sphere_mcs(sc)
+    text = (f"_MVAR=1 _MA=1 _SETVAL={SPHERE_D} _SETV[0]={c[0]:.4f} _SETV[1]={c[1]:.4f} _SETV[2]={c[2]:.4f} "
+            "_SETV[3]=3 _STA1=-45 _INCA=45 _FA=5\nCYCLE996\nM30")
+    with make_client(tmp_path, sc) as client:
+        run = post(client, "/api/nc/run", {"mda": text})
+        assert run["state"] == "done", run
+        names = ",".join(f"_OVR[{i}]" for i in range(13)) + ",_OVI[11]"
+        values = client.get("/api/nc/variables", params={"names": names}).json()
+        flat = values.get("variables", values)
+        ovr = [float(flat[f"_OVR[{i}]"]) for i in range(13)]
+        distance, angle = line_errors({"point": ovr[0:3], "direction": ovr[3:6]}, TRUE_HEAD["A"])
+        assert distance < 1e-6 and angle < 1e-6                     # noise-free: exact
+        assert int(flat["_OVI[11]"]) == 1
+        assert abs(ovr[12] - SPHERE_D) < 1e-6
+        stored = client.get("/api/kinematics").json()["A"]
+        assert np.allclose(stored["point"], ovr[0:3], atol=1e-9)

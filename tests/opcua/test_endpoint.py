@@ -12,6 +12,7 @@ import pytest
 from asyncua import ua
 from hmi_testdata import PROBE_LENGTH, TEST_SCENARIO
 from opc_kit import USERS, node, opc_client, run, wait_for
+from waiting import wait_until
 
 
 def ok(response, status: int = 200):
@@ -220,3 +221,30 @@ def test_the_level_is_read_again_at_every_write(live):
     finally:
         services.settings.put({"level_offsets": 2}, source="tests")
     assert ok(live.http.get("/api/offsets/G57"))["trans"]["X"] == 3.0
+
+
+def test_failed_opc_ua_sign_ins_hold_only_opc_ua_of_that_computer(live):
+    """Issue 25 item 2: five wrong OPC UA passwords make this computer wait on OPC UA (the right
+    password too, for a second), while HTTP sign-in of the same user from it goes on; the wait ends."""
+    import httpx
+
+    async def connect(password: str):
+        async with opc_client(live.opc_url, "serv", password):
+            return "session"
+
+    for _ in range(5):
+        with pytest.raises(ua.UaStatusCodeError):
+            run(connect("not-the-password"))
+    with pytest.raises(ua.UaStatusCodeError):
+        run(connect(USERS["serv"][0]))                      # this computer waits now, right or wrong
+    with httpx.Client(base_url=live.http.base_url) as browser:
+        signed = browser.post("/api/session", json={"user": "serv", "password": USERS["serv"][0]})
+        assert signed.status_code == 200 and signed.json()["name"] == "serv"
+
+    def right_password_signs_in():
+        try:
+            return run(connect(USERS["serv"][0]))
+        except ua.UaStatusCodeError:
+            return None
+
+    assert wait_until(right_password_signs_in, "the OPC UA wait ends", 30) == "session"

@@ -10,7 +10,7 @@ runs the JOG task that measures the same feature through the JOG workflow on the
 
 from __future__ import annotations
 
-from app.nc.cycles import calibration, protocol, sphere, workpiece
+from app.nc.cycles import calibration, kinematics, protocol, sphere, workpiece
 from app.nc.cycles.base import CycleHost, NcMeasuring
 
 CYCLE_NAMES = ("CYCLE976", "CYCLE977", "CYCLE978", "CYCLE979", "CYCLE998", "CYCLE961", "CYCLE997", "CYCLE971")
@@ -20,10 +20,11 @@ PROTOCOL_CYCLES = ("CYCLE100", "CYCLE101", "CYCLE105", "CYCLE106", "CYCLE113", "
 
 def measuring_cycles(host: CycleHost) -> dict:
     handlers = {**workpiece.handlers(host), **sphere.handlers(host), **calibration.handlers(host)}
+    product = kinematics.handlers(host)     # CYCLE996-like (design.md §10.6): a product cycle, no form
     if getattr(host, "protocol_files", None) is None:
-        return {name: handlers[name] for name in CYCLE_NAMES}
+        return {**{name: handlers[name] for name in CYCLE_NAMES}, **product}
     log = protocol.ProtocolLog(host)        # type: ignore[arg-type]
-    return {**{name: log.logged(name, handlers[name]) for name in CYCLE_NAMES}, **log.handlers()}
+    return {**{name: log.logged(name, handlers[name]) for name in CYCLE_NAMES}, **log.handlers(), **product}
 
 
 __all__ = ["CYCLE_NAMES", "PROTOCOL_CYCLES", "CycleHost", "NcMeasuring", "measuring_cycles"]
