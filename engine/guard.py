@@ -219,14 +219,20 @@ def first_contact(model: ProtectionModel, c0: npt.ArrayLike, c1: npt.ArrayLike, 
             g, name = at(s)
         if g - radius <= CONTACT_EPS:
             return None
-    for _ in range(MAX_TRACE_STEPS):
-        g, name = at(s)
+    # the rest of the way at once: the distance changes no faster than the path (1-Lipschitz), so
+    # with the gap at s and the gap at the end the ball stays > CONTACT_EPS clear when the two
+    # exceed the way left by 2·CONTACT_EPS (a retract, a move through free space: no stepping)
+    end_gap = at(length)[0] - radius
+    for _ in range(MAX_TRACE_STEPS):          # g, name: the distance at s
         gap = g - radius
         if gap <= CONTACT_EPS:
             return s, name
+        if gap + end_gap > (length - s) + 2.0 * CONTACT_EPS:
+            return None
         s += gap
         if s > length:
             return None
+        g, name = at(s)
     return s, name          # a grazing pass that never resolves: treated as a contact
 
 

@@ -3,7 +3,9 @@
 Pure: yields steps, receives latches (engine.plan). Coordinates are MCS of the NC's ball centre
 (the executor converts with the control's kinematic data). One position:
 
-1. up to a safe height (the start height, or 2·ρ' above the sphere), across above the sphere;
+1. up to a safe height (the start height, 2·ρ' above the sphere, or ``swivel_z``: up to the probe
+   length higher, as far as the Z limit allows, since a head axis swings the ball sideways by up to
+   L·sin θ), across above the sphere;
 2. turn the measured axis to its position, every other rotary axis to 0 (the zero position the
    axis lines refer to, jog-measuring §6.3 "basic position of the machine kinematics");
 3. over the sphere where the control expects it now (a table turns it, DIN 66217: −θ about the
@@ -64,6 +66,7 @@ class SphereProgram:
     # turns about the tool axis at the zero position: the inner one tilts the probe off it)
     partner: tuple[str, float] | None = None
     reference: bool = False              # this point: every rotary axis at 0 (the sphere's place)
+    swivel_z: float | None = None        # ball height (MCS) to turn the axes at: clear of what stands nearby
 
     def expected_centre(self) -> FloatArray:
         """Where the control expects the sphere at ``angle``: fixed for a head, turned by −θ about
@@ -105,7 +108,8 @@ def sphere_position_program(prog: SphereProgram, start: FloatArray, label: str
     rho_start = prog.sphere_diameter / 2.0 + prog.ball_radius + prog.clearance
     fixed = np.asarray(prog.sphere, dtype=float)
     centre = fixed if prog.reference else prog.expected_centre()
-    safe_z = max(float(start[2]), float(fixed[2]) + 2.0 * rho_start, float(centre[2]) + 2.0 * rho_start)
+    safe_z = max(float(start[2]), float(fixed[2]) + 2.0 * rho_start, float(centre[2]) + 2.0 * rho_start,
+                 -math.inf if prog.swivel_z is None else float(prog.swivel_z))
     here = np.asarray(start, dtype=float)
     yield MoveStep(np.array([here[0], here[1], safe_z]), None, coords="MCS", label=f"{label} up")
     yield MoveStep(np.array([fixed[0], fixed[1], safe_z]), None, coords="MCS", label=f"{label} over the sphere")

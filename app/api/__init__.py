@@ -16,6 +16,7 @@ from app.access.deps import guard
 
 from . import (
     access,
+    cycles,
     data,
     events,
     kinematics,
@@ -59,7 +60,7 @@ ERRORS: dict[int | str, dict[str, Any]] = {"4XX": {"model": ErrorEnvelope, "desc
                                                          "415 non-JSON body, 422 validation"}}
 api_router = APIRouter(prefix="/api", generate_unique_id_function=operation_id, dependencies=[Depends(guard)],
                        responses=ERRORS)
-for module in (machine, data, measure, setup_support, plc, access, nc, programs, lathe, events, results, probe_test, plant,
+for module in (machine, data, measure, setup_support, plc, access, nc, programs, cycles, lathe, events, results, probe_test, plant,
                kinematics):
     for route in module.router.routes:
         if isinstance(route, APIRoute) and route.summary is None:

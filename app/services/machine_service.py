@@ -719,6 +719,11 @@ class MachineService:
         return chain_of(self.stored_frames(), active)
 
     def activate(self, name: str) -> dict:
+        self.make_active(name)
+        return self.status()
+
+    def make_active(self, name: str) -> None:
+        """``activate`` without building the state to answer (a measurement's commit needs none)."""
         if not isinstance(name, str) or not self._is_settable(name.upper()):
             raise InvalidInput(f"offset: {name!r} is not a settable zero offset (G500, G54..)", field="offset")
         name = name.upper()
@@ -733,7 +738,6 @@ class MachineService:
             if changed:          # re-activating the same WO (after a correction) needs no write
                 with self._db.unit() as unit:
                     unit.set_state(STATE_ACTIVE_OFFSET, name)
-        return self.status()
 
     def _check_chain_holds(self, name: str) -> None:
         """Every frame of the chain ``name`` would make active (the basic frames and ``name``) is one
@@ -750,7 +754,7 @@ class MachineService:
 
     def refresh_frame(self) -> None:
         """Re-compose the active chain after an offset was written (BASIC_*, or the active WO)."""
-        self.activate(self._active_offset)
+        self.make_active(self._active_offset)
 
     # --- scenario -----------------------------------------------------------------------------
     def _simulator(self, what: str) -> SimulatorControl:
@@ -776,7 +780,7 @@ class MachineService:
             self._scenario = scenario
             self._seed_data(reset=reset_data)
             self._push_nc_data()
-            self.activate(G500 if reset_data else self._active_offset)
+            self.make_active(G500 if reset_data else self._active_offset)
             with self._db.unit(readonly=True) as unit:
                 tool = unit.get_state(STATE_TOOL, None)
             self._restore_tool(tool)

@@ -189,7 +189,7 @@ class MeasuringEnv:
         scenario = self._ms.scenario
         limits = scenario.limits() if isinstance(scenario, Scenario) else {}
         return {"lines": lines, "rotary_axes": self._ms.rotary_axes,
-                "limits": {a: tuple(v) for a, v in limits.items() if a in lines}}
+                "limits": {a: tuple(v) for a, v in limits.items() if a in lines or a == "Z"}}
 
     def _commit(self, offset, log_entry, probe_update, tool_update, tool_probe_update, tool_offset, source,
                 kinematics_update=None):
@@ -310,7 +310,7 @@ class MeasuringEnv:
             unit.add_audit("guard", task, {"guard": True}, {"guard": False}, "measure", {"task": task})
 
     def activate(self, name: str) -> None:
-        self._ms.activate(name)
+        self._ms.make_active(name)
 
     def refresh_frames(self) -> None:
         self._ms.refresh_frame()

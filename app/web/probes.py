@@ -82,14 +82,7 @@ def _health(request: Request, n: int, record: dict, settings) -> dict:
 def parse_form(form, stored: dict, lathe: bool = False) -> tuple[dict, dict[str, str]]:
     """Form -> record (the stored record with the edited fields), {field: error}."""
     errors: dict[str, str] = {}
-    old = stored.get("trigger") or {}
-    triggers = LATHE_TRIGGERS if lathe else TRIGGERS
-    edited = {key for key, _index, _text in triggers}
-    trigger = {k: v for k, v in old.items() if k not in edited}
-    for key, _index, _text in triggers:
-        value = number(form.get(f"trigger.{key}", ""), f"trigger.{key}", errors, old.get(key))
-        if value is not None:
-            trigger[key] = value
+    trigger = _triggers(form, stored.get("trigger") or {}, LATHE_TRIGGERS if lathe else TRIGGERS, errors)
     record = {**stored, "trigger": trigger}
     for name in ("ball_diameter", "effective_diameter"):
         value = number(form.get(name, ""), name, errors, stored.get(name))
@@ -98,19 +91,9 @@ def parse_form(form, stored: dict, lathe: bool = False) -> tuple[dict, dict[str,
                 errors[name] = "required"
             record[name] = 0.0 if value is None else value
     if lathe:                                    # _WP[k,7]/[8]: position deviation Z, X
-        deviation = dict(stored.get("position_deviation") or {})
-        for axis in "ZX":
-            value = number(form.get(f"position_deviation.{axis}", ""), f"position_deviation.{axis}", errors,
-                           deviation.get(axis))
-            deviation[axis] = deviation.get(axis, 0.0) if value is None else value
-        record["position_deviation"] = deviation
+        record["position_deviation"] = _position_deviation(form, stored, errors)
     else:
-        skew = []
-        for i, axis in enumerate("XY"):
-            old = (stored.get("skew") or [0.0, 0.0])[i]
-            value = number(form.get(f"skew.{axis}", ""), f"skew.{axis}", errors, old)
-            skew.append(old if value is None else value)
-        record["skew"] = skew
+        record["skew"] = _skew(form, stored, errors)
     tool_text = str(form.get("tool", "")).strip()
     if tool_text == "":
         record["tool"] = None
@@ -119,7 +102,44 @@ def parse_form(form, stored: dict, lathe: bool = False) -> tuple[dict, dict[str,
             record["tool"] = int(tool_text)
         except ValueError:
             errors["tool"] = f"{tool_text!r} is not a tool number"
-    for axis in ("ZX" if lathe else "XY"):
+    _trigger_signs(trigger, "ZX" if lathe else "XY", errors)
+    if record.get("lobing") and any(record.get(k) != stored.get(k) for k in ("trigger", "effective_diameter", "skew")):
+        record["lobing"] = None          # the calibrated trigger map no longer agrees with typed values
+    return record, errors
+
+
+def _triggers(form, old: dict, triggers, errors: dict[str, str]) -> dict:
+    """The stored trigger values with the form's (those the form does not edit kept)."""
+    edited = {key for key, _index, _text in triggers}
+    trigger = {k: v for k, v in old.items() if k not in edited}
+    for key, _index, _text in triggers:
+        value = number(form.get(f"trigger.{key}", ""), f"trigger.{key}", errors, old.get(key))
+        if value is not None:
+            trigger[key] = value
+    return trigger
+
+
+def _position_deviation(form, stored: dict, errors: dict[str, str]) -> dict:
+    deviation = dict(stored.get("position_deviation") or {})
+    for axis in "ZX":
+        value = number(form.get(f"position_deviation.{axis}", ""), f"position_deviation.{axis}", errors,
+                       deviation.get(axis))
+        deviation[axis] = deviation.get(axis, 0.0) if value is None else value
+    return deviation
+
+
+def _skew(form, stored: dict, errors: dict[str, str]) -> list:
+    skew = []
+    for i, axis in enumerate("XY"):
+        old = (stored.get("skew") or [0.0, 0.0])[i]
+        value = number(form.get(f"skew.{axis}", ""), f"skew.{axis}", errors, old)
+        skew.append(old if value is None else value)
+    return skew
+
+
+def _trigger_signs(trigger: dict, axes: str, errors: dict[str, str]) -> None:
+    """t(+) < 0 and t(−) > 0: the ball centre switches before (+) resp. past (−) the wall."""
+    for axis in axes:
         plus, minus = trigger.get(f"{axis}+"), trigger.get(f"{axis}-")
         if plus is not None and plus >= 0:
             errors[f"trigger.{axis}+"] = (f"must be negative: travel +{axis} switches with "
@@ -127,9 +147,6 @@ def parse_form(form, stored: dict, lathe: bool = False) -> tuple[dict, dict[str,
         if minus is not None and minus <= 0:
             errors[f"trigger.{axis}-"] = (f"must be positive: travel −{axis} switches with "
                                             "the ball centre past the wall")
-    if record.get("lobing") and any(record.get(k) != stored.get(k) for k in ("trigger", "effective_diameter", "skew")):
-        record["lobing"] = None          # the calibrated trigger map no longer agrees with typed values
-    return record, errors
 
 
 def _screen(request: Request, probes, settings, machine, n: int | None = None, record: dict | None = None,

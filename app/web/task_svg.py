@@ -189,53 +189,74 @@ def _result_points(view: View, r: dict) -> None:
 
 
 def _result(view: View, task: str, r: dict, plane: Plane) -> None:
-    half = 1000.0
+    """The result drawn over the set-up: position lines, then the one feature figure (corner,
+    aligned edge, edge distance or centred shape), the two points, the plane's trace."""
     pts = [view.uv(p) for p in r.get("points") or [] if isinstance(p, dict)]
     position = r.get("position")
     if isinstance(position, dict):
         for axis, value in position.items():
-            if axis == view.u:
-                view.line((value, -half), (value, half), "result-line", keep=False)
-            elif axis == view.v:
-                view.line((-half, value), (half, value), "result-line", keep=False)
+            _axis_line(view, axis, value, "result-line")
     if "corner" in r and view.name == "top":
-        p0 = view.uv(r["corner"])
-        angle = float(r.get("angle", 0.0))
-        angle2 = float(r["angle_2"]) if "angle_2" in r else angle + 90.0
-        view.infinite_line(p0, angle, "result-line", half)
-        view.infinite_line(p0, angle2, "result-line", half)
-        view.circle(p0, 1.5, "result-point")
-        view.text((p0[0] + 2, p0[1] - 5), "P0", "label result")
+        _corner(view, r)
     elif task == "edge.align" and len(pts) == 2 and view.name == "top":
         view.line(_extend(pts[0], pts[1], -0.5), _extend(pts[0], pts[1], 1.5), "result-line")
     elif task == "edge.distance" and len(pts) == 2:
-        axis = r.get("axis")
-        centre = (r.get("center") or {}).get(axis)
-        for value in [p[axis] for p in r["points"]] + ([centre] if centre is not None else []):
-            cls = "result-line" if value != centre else "result-centre"
-            if axis == view.u:
-                view.line((value, -half), (value, half), cls, keep=False)
-            elif axis == view.v:
-                view.line((-half, value), (half, value), cls, keep=False)
+        _edge_distance(view, r)
     elif "center" in r and view.name == "top":
-        c = view.uv(r["center"])
-        if "diameter" in r:
-            view.circle(c, float(r["diameter"]) / 2.0, "result-shape")
-        elif "length" in r and "width" in r and isinstance(r["length"], float):
-            view.rect(c, float(r["length"]), float(r["width"]), "result-shape")
-        if "angle" in r and pts:
-            view.infinite_line(c, float(r["angle"]), "result-centre", half)
-        view.circle(c, 1.5, "result-point")
-        view.text((c[0] + 2, c[1] - 5), "P0", "label result")
+        _centred_shape(view, r, bool(pts))
     if "p1" in r and "p2" in r and view.name == "top":
         view.line(view.uv(r["p1"]), view.uv(r["p2"]), "result-line")
     if "alpha" in r and "beta" in r:
-        pts3 = [p for p in r.get("points") or [] if isinstance(p, dict)]
-        if view.name == "side" and len(pts3) >= 2:
-            # trace of the measured plane: a line through the outermost touches along the 1st axis
-            ends = sorted((view.uv(p) for p in pts3), key=lambda q: q[0])
-            view.line(_extend(ends[0], ends[-1], -0.1), _extend(ends[0], ends[-1], 1.1), "result-line")
-        view.caption = f"α {fixed(r['alpha'], 4)}°  β {fixed(r['beta'], 4)}°"
+        _plane_trace(view, r)
+
+
+HALF = 1000.0          # half length of a line drawn across the whole view (mm)
+
+
+def _axis_line(view: View, axis, value: float, cls: str) -> None:
+    """A line across the view where ``axis`` has ``value`` (nothing when the view does not show it)."""
+    if axis == view.u:
+        view.line((value, -HALF), (value, HALF), cls, keep=False)
+    elif axis == view.v:
+        view.line((-HALF, value), (HALF, value), cls, keep=False)
+
+
+def _corner(view: View, r: dict) -> None:
+    p0 = view.uv(r["corner"])
+    angle = float(r.get("angle", 0.0))
+    angle2 = float(r["angle_2"]) if "angle_2" in r else angle + 90.0
+    view.infinite_line(p0, angle, "result-line", HALF)
+    view.infinite_line(p0, angle2, "result-line", HALF)
+    view.circle(p0, 1.5, "result-point")
+    view.text((p0[0] + 2, p0[1] - 5), "P0", "label result")
+
+
+def _edge_distance(view: View, r: dict) -> None:
+    axis = r.get("axis")
+    centre = (r.get("center") or {}).get(axis)
+    for value in [p[axis] for p in r["points"]] + ([centre] if centre is not None else []):
+        _axis_line(view, axis, value, "result-line" if value != centre else "result-centre")
+
+
+def _centred_shape(view: View, r: dict, has_points: bool) -> None:
+    c = view.uv(r["center"])
+    if "diameter" in r:
+        view.circle(c, float(r["diameter"]) / 2.0, "result-shape")
+    elif "length" in r and "width" in r and isinstance(r["length"], float):
+        view.rect(c, float(r["length"]), float(r["width"]), "result-shape")
+    if "angle" in r and has_points:
+        view.infinite_line(c, float(r["angle"]), "result-centre", HALF)
+    view.circle(c, 1.5, "result-point")
+    view.text((c[0] + 2, c[1] - 5), "P0", "label result")
+
+
+def _plane_trace(view: View, r: dict) -> None:
+    pts3 = [p for p in r.get("points") or [] if isinstance(p, dict)]
+    if view.name == "side" and len(pts3) >= 2:
+        # trace of the measured plane: a line through the outermost touches along the 1st axis
+        ends = sorted((view.uv(p) for p in pts3), key=lambda q: q[0])
+        view.line(_extend(ends[0], ends[-1], -0.1), _extend(ends[0], ends[-1], 1.1), "result-line")
+    view.caption = f"α {fixed(r['alpha'], 4)}°  β {fixed(r['beta'], 4)}°"
 
 
 def _extend(a, b, t: float) -> tuple[float, float]:

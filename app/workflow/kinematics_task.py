@@ -126,6 +126,18 @@ def _line(facts: dict, axis: str) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(line["point"], dtype=float), np.asarray(line["direction"], dtype=float)
 
 
+def _swivel_z(params: dict, facts: dict, ctx: MeasuringContext, rho: float) -> float | None:
+    """Ball height to turn the axes at: the probe length above the hub (2ρ' over the sphere), at
+    most 1 mm below where the Z limit puts the ball; None without a Z limit."""
+    z_limit = facts.get("limits", {}).get("Z")
+    if z_limit is None:
+        return None
+    v = _probe_vector(ctx)
+    rho_start = float(params["sphere"]["diameter"]) / 2.0 + rho + float(params["clearance"])
+    wanted = float(params["sphere"]["center"][2]) + 2.0 * rho_start + float(np.linalg.norm(v))
+    return min(wanted, float(z_limit[1]) + float(v[2]) - 1.0)
+
+
 def _program(params: dict, n: int, start, ctx: MeasuringContext, label: str):
     facts = _machine_facts(ctx)
     axis = params["axis"]
@@ -142,7 +154,7 @@ def _program(params: dict, n: int, start, ctx: MeasuringContext, label: str):
         sphere=np.asarray(params["sphere"]["center"], dtype=float), sphere_diameter=float(params["sphere"]["diameter"]),
         ball_radius=rho, clearance=float(params["clearance"]),
         measuring_feed=float(ctx.settings.measuring_feed), position_feed=float(ctx.settings.position_feed),
-        table_line=_line(facts, axis) if kind == TABLE else None)
+        table_line=_line(facts, axis) if kind == TABLE else None, swivel_z=_swivel_z(params, facts, ctx, rho))
     return sphere_position_program(prog, np.asarray(start, dtype=float), label)
 
 

@@ -3,10 +3,13 @@ the real error envelope; the command line's access subcommands and the non-loopb
 
 from __future__ import annotations
 
+import io
 import re
 import subprocess
 import sys
+from contextlib import redirect_stderr, redirect_stdout
 from pathlib import Path
+from unittest.mock import patch
 
 import fastapi.routing
 from access_helpers import error_of
@@ -89,8 +92,27 @@ def test_docs_stay_reachable_with_sign_in_on_and_try_it_out_gets_the_levels(sign
 # --- command line -------------------------------------------------------------------------------------
 
 def run_cli(*args, stdin: str = "", env_db: Path) -> subprocess.CompletedProcess:
+    """``python -m app --db <env_db> ...`` as a process, as the operator runs it."""
     return subprocess.run([sys.executable, "-m", "app", "--db", str(env_db), *args], cwd=ROOT, input=stdin,
                           capture_output=True, text=True, timeout=120)
+
+
+def run_cli_here(*args, stdin: str = "", env_db: Path) -> subprocess.CompletedProcess:
+    """The same command through ``app.__main__.main`` in this process (no interpreter start per
+    call): the exit code and the printed lines as ``python -m app`` gives them (``sys.exit(text)``
+    prints the text to stderr and exits 1)."""
+    from app.__main__ import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with redirect_stdout(out), redirect_stderr(err), patch.object(sys, "stdin", io.StringIO(stdin)):
+        try:
+            main(["--db", str(env_db), *args])
+            code = 0
+        except SystemExit as exc:
+            if isinstance(exc.code, str):
+                print(exc.code, file=sys.stderr)
+            code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+    return subprocess.CompletedProcess(args, code, out.getvalue(), err.getvalue())
 
 
 def test_cli_user_and_token_add_then_the_api_answers_by_level(tmp_path, scenario_file):
@@ -98,14 +120,14 @@ def test_cli_user_and_token_add_then_the_api_answers_by_level(tmp_path, scenario
     added = run_cli("user", "add", "anna", "--level", "3", stdin="s3cret-pw\n", env_db=db)
     assert added.returncode == 0, added.stderr
     assert "sign-in is on" in added.stdout
-    low = run_cli("token", "add", "mes", "--level", "7", env_db=db)
-    high = run_cli("token", "add", "writer", "--level", "5", env_db=db)
+    low = run_cli_here("token", "add", "mes", "--level", "7", env_db=db)
+    high = run_cli_here("token", "add", "writer", "--level", "5", env_db=db)
     assert low.returncode == 0 and low.stdout.strip().startswith("hmi_") and "shown only now" in low.stderr
-    listed = run_cli("token", "list", env_db=db)
+    listed = run_cli_here("token", "list", env_db=db)
     assert "mes\tlevel 7" in listed.stdout and low.stdout.strip() not in listed.stdout
-    assert run_cli("user", "add", "anna", "--level", "2", stdin="other-pw\n", env_db=db).returncode == 1
-    assert run_cli("user", "add", "bob", "--level", "3", stdin="ab\n", env_db=db).returncode == 1   # too short
-    assert run_cli("keyswitch", "2", env_db=db).stdout.strip() == "keyswitch turned to position 2 = level 5"
+    assert run_cli_here("user", "add", "anna", "--level", "2", stdin="other-pw\n", env_db=db).returncode == 1
+    assert run_cli_here("user", "add", "bob", "--level", "3", stdin="ab\n", env_db=db).returncode == 1   # too short
+    assert run_cli_here("keyswitch", "2", env_db=db).stdout.strip() == "keyswitch turned to position 2 = level 5"
 
     from fastapi.testclient import TestClient
 
@@ -140,7 +162,7 @@ def test_a_non_loopback_host_without_users_does_not_start(tmp_path):
     settings = settings_from_args(parse_args(["--db", str(db), "--host", "0.0.0.0"]))
     assert refuse_open_trainer(settings)
     assert refuse_open_trainer(settings_from_args(parse_args(["--db", str(db)]))) is None
-    assert run_cli("user", "add", "anna", "--level", "1", stdin="s3cret-pw\n", env_db=db).returncode == 0
+    assert run_cli_here("user", "add", "anna", "--level", "1", stdin="s3cret-pw\n", env_db=db).returncode == 0
     assert refuse_open_trainer(settings) is None
 
 

@@ -1,0 +1,182 @@
+"""Cycle support of the program editor (design.md §10.2, manual §7.2–7.3): the measuring cycles
+as input screens whose fields are the manual's parameters, the text the editor inserts (the
+parameter assignments and the call, SW 6.3 style: parameters set before the call, manual §2.2),
+and the way back from such a text to the form. ``read(render(c, p)) == (c, p)`` exactly:
+integers stay integers, reals are written with Python's shortest round-trip representation.
+
+    fields = CYCLES["CYCLE977"]                 # the form: parameter name, operator text, kind
+    text = render("CYCLE977", {"_MVAR": 101, "_SETVAL": 20.0, "_KNUM": 1})
+    read(text) == ("CYCLE977", {"_MVAR": 101, "_SETVAL": 20.0, "_KNUM": 1})
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+from app.i18n import N_
+from app.nc import nodes as n
+from app.nc.errors import NcSyntaxError
+from app.nc.parser import parse_program
+
+
+@dataclass(frozen=True)
+class CycleField:
+    name: str            # the manual's parameter name: _MVAR, _SETV[0], _CHBIT[4]
+    text: str            # the operator text (catalogue msgid)
+    kind: str            # "int" or "real"
+    default: int | float = 0
+    low: float = -1e9
+    high: float = 1e9
+
+    def to_api(self, translate) -> dict:
+        return {"name": self.name, "text": translate(self.text), "kind": self.kind, "default": self.default,
+                "min": self.low, "max": self.high}
+
+
+def _int(name: str, text: str, default: int = 0, low: float = 0, high: float = 1e9) -> CycleField:
+    return CycleField(name, text, "int", default, low, high)
+
+
+def _real(name: str, text: str, default: float = 0.0, low: float = -1e5, high: float = 1e5) -> CycleField:
+    return CycleField(name, text, "real", default, low, high)
+
+
+# the auxiliary parameters every cycle reads (manual §2.3)
+_COMMON = (
+    _int("_PRNUM", N_("Probe number"), 1, 1, 3),
+    _real("_VMS", N_("Measuring feed (0: default)"), 0.0, 0.0, 10000.0),
+    _int("_NMSP", N_("Measurements at one place"), 1, 1, 99),
+    _real("_FA", N_("Measuring path"), 2.0, 0.001, 1000.0),
+    _real("_TSA", N_("Safe area"), 1.0, 0.0, 1e5),
+)
+_TOOL_OFFSET = (
+    _int("_TNUM", N_("Tool number for the offset"), 0, 0, 32000),
+    _real("_TUL", N_("Upper tolerance")), _real("_TLL", N_("Lower tolerance")),
+    _real("_TZL", N_("Zero offset range"), 0.0, 0.0, 1e5), _real("_TMV", N_("Mean value range"), 0.0, 0.0, 1e5),
+    _real("_TDIF", N_("Dimension difference"), 0.0, 0.0, 1e5),
+    _int("_K", N_("Weighting factor for averaging"), 1, 1, 1000), _int("_EVNUM", N_("Empirical value memory"), 0),
+)
+_VARIANT = _int("_MVAR", N_("Measuring variant"), 0, 0, 999999)
+_SETVAL = _real("_SETVAL", N_("Setpoint"))
+_AXIS = _int("_MA", N_("Measuring axis"), 1, 1, 3)
+_KNUM = _int("_KNUM", N_("Correction target (zero offset or tool offset)"), 0, 0, 9999999)
+_INFEED = _real("_ID", N_("Infeed / offset"))
+
+CYCLES: dict[str, tuple[CycleField, ...]] = {
+    "CYCLE976": (_VARIANT, _SETVAL, _AXIS, _int("_MD", N_("Measuring direction (0 +, 1 −)"), 1, 0, 1),
+                 *_COMMON, _real("_TZL", N_("Zero offset range"), 0.0, 0.0, 1e5)),
+    "CYCLE977": (_VARIANT, _SETVAL, _real("_SETV[0]", N_("Setpoint length")), _real("_SETV[1]", N_("Setpoint width")),
+                 _AXIS, _INFEED, _KNUM, *_COMMON, *_TOOL_OFFSET),
+    "CYCLE978": (_VARIANT, _SETVAL, _AXIS, _KNUM, *_COMMON, *_TOOL_OFFSET),
+    "CYCLE979": (_VARIANT, _SETVAL, _real("_CPA", N_("Centre point, abscissa")),
+                 _real("_CPO", N_("Centre point, ordinate")), _real("_STA1", N_("Starting angle")),
+                 _real("_INCA", N_("Indexing angle")), _KNUM, *_COMMON, *_TOOL_OFFSET),
+    "CYCLE998": (_VARIANT, _SETVAL, _real("_SETV[0]", N_("Setpoint of the second angle")), _AXIS, _INFEED,
+                 _real("_STA1", N_("Starting angle")), _real("_RA", N_("Rotary axis correction")), _KNUM, *_COMMON),
+    "CYCLE961": (_VARIANT, _real("_SETV[0]", N_("Setpoint length")), _real("_SETV[1]", N_("Setpoint width")),
+                 _real("_STA1", N_("Starting angle")), _real("_INCA", N_("Indexing angle")), _INFEED, _KNUM,
+                 *_COMMON),
+    "CYCLE997": (_VARIANT, _SETVAL, _KNUM, _real("_TNVL", N_("Limit of the distortion"), 0.0, 0.0, 1e5), *_COMMON),
+    "CYCLE971": (_VARIANT, _AXIS, _INFEED, _int("_CHBIT[3]", N_("Correct the wear (1) or the geometry (0)"), 0, 0, 1),
+                 *_COMMON, _real("_TZL", N_("Zero offset range"), 0.0, 0.0, 1e5),
+                 _real("_TDIF", N_("Dimension difference"), 0.0, 0.0, 1e5)),
+}
+
+
+class CycleFormError(ValueError):
+    """Bad input to the cycle support, naming the field (``cycle``, ``params.<name>``, ``text``)."""
+
+    def __init__(self, field: str, message: str):
+        super().__init__(message)
+        self.field = field
+        self.message = message
+
+
+def fields_of(cycle: str) -> dict[str, CycleField]:
+    if cycle not in CYCLES:
+        raise CycleFormError("cycle", f"{cycle!r} is not a measuring cycle of the editor's cycle support "
+                             f"({', '.join(CYCLES)})")
+    return {f.name: f for f in CYCLES[cycle]}
+
+
+def _value(field: CycleField, value: object) -> int | float:
+    where = f"params.{field.name}"
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise CycleFormError(where, f"{field.name} must be a number, got {value!r}")
+    if field.kind == "int":
+        if float(value) != int(value):
+            raise CycleFormError(where, f"{field.name} must be a whole number, got {value!r}")
+        value = int(value)
+    else:
+        value = float(value)
+    if not field.low <= value <= field.high:
+        raise CycleFormError(where, f"{field.name} must lie in {field.low:g}..{field.high:g}, got {value!r}")
+    return value
+
+
+def _text_of(value: int | float) -> str:
+    return str(value) if isinstance(value, int) else repr(float(value))
+
+
+def render(cycle: str, params: dict) -> str:
+    """The assignments in the form's order and the call: ``_MVAR=101 _SETVAL=20.0\\nCYCLE977``."""
+    fields = fields_of(cycle)
+    if not isinstance(params, dict):
+        raise CycleFormError("params", "params must be an object of the cycle's parameters")
+    unknown = [k for k in params if k not in fields]
+    if unknown:
+        raise CycleFormError(f"params.{unknown[0]}", f"{unknown[0]} is not a parameter of {cycle} "
+                             f"({', '.join(fields)})")
+    words = [f"{name}={_text_of(_value(field, params[name]))}" for name, field in fields.items() if name in params]
+    lines, line = [], ""
+    for word in words:                  # blocks well below the NC's 512 characters
+        if line and len(line) + 1 + len(word) > 72:
+            lines.append(line)
+            line = ""
+        line = f"{line} {word}" if line else word
+    if line:
+        lines.append(line)
+    return "\n".join([*lines, cycle])
+
+
+_INDEX = re.compile(r"^\d+$")
+
+
+def _constant(expr) -> int | float | None:
+    if isinstance(expr, n.Num):
+        return expr.value
+    if isinstance(expr, n.Unary) and expr.op in "+-" and isinstance(expr.operand, n.Num):
+        return -expr.operand.value if expr.op == "-" else expr.operand.value
+    return None
+
+
+def read(text: str) -> tuple[str, dict]:
+    """The last measuring-cycle call of ``text`` and the constant values its parameters were given
+    before it (what the editor's form shows when the operator opens the call)."""
+    if not isinstance(text, str):
+        raise CycleFormError("text", "text must be the program text")
+    try:
+        program = parse_program(text, "EDITOR")
+    except NcSyntaxError as exc:
+        raise CycleFormError("text", f"line {exc.line}: {exc.message}") from None
+    seen: dict[str, int | float] = {}
+    found: tuple[str, dict] | None = None
+    for block in program.blocks:
+        for word in block.words:
+            if isinstance(word, n.Assign) and len(word.values) == 1:
+                indices = [_constant(i) for i in word.target.indices]
+                if any(i is None for i in indices):
+                    continue
+                name = word.target.name.upper() + ("" if not indices else
+                                                   "[" + ",".join(str(int(i)) for i in indices if i is not None) + "]")
+                value = _constant(word.values[0])
+                if value is not None:
+                    seen[name] = value
+            elif isinstance(word, n.CycleCall) and word.name.upper() in CYCLES:
+                fields = fields_of(word.name.upper())
+                found = (word.name.upper(), {k: _value(fields[k], v) for k, v in seen.items() if k in fields})
+    if found is None:
+        raise CycleFormError("text", f"the text calls no measuring cycle of the cycle support ({', '.join(CYCLES)})")
+    return found
