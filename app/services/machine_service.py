@@ -744,7 +744,7 @@ class MachineService:
         the NC holds (design.md §10.7, issue 34 §5): LinuxCNC holds no rotation about X or Y and no
         basic frame, so such an activation is refused with the NC's alarm (409, 61321), nothing
         shown as active that the NC does not move by."""
-        if not callable(getattr(self._machine, "holds", None)):
+        if not isinstance(self._machine, FrameCapacity):
             return
         with self._db.unit(readonly=True) as unit:
             stored = unit.list_offsets()
