@@ -330,6 +330,10 @@ class WorkflowService:
         self._check_probe_ready(spec, ctx)
         self._check_probe_geometry(spec, ctx)
         warnings = self._warnings(spec, ctx)
+        tilt = getattr(self._env, "unaligned_tilt_warning", None)
+        tilted = tilt() if callable(tilt) and spec.needs_probe and spec.category == Category.WORKPIECE else None
+        if tilted and session.task != "plane.align":
+            warnings.append(tilted)
         if self._refuse_override(ctx):
             raise WorkflowError(409, "override_mismatch", warnings[-1])
         distrust = probe_trust.findings(spec, session.params, n, ctx, self._env.machine)
