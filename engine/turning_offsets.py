@@ -124,6 +124,31 @@ class ToolTarget:
         return LENGTH_OF_AXIS[axis]
 
 
+def _knum_digits(n: int) -> tuple[int, int, int, int]:
+    """Digits 4..7 of _KNUM, each checked (61321..61324 resp. 61407)."""
+    d4, d5, d6, d7 = (n // 1000) % 10, (n // 10_000) % 10, (n // 100_000) % 10, (n // 1_000_000) % 10
+    if d4 not in (0, 1, 2):
+        raise MeasuringError(alarms.KNUM_DIGIT4, f"_KNUM={n}: 4th digit {d4} must be 0, 1 or 2")
+    if d5 not in (0, 1):
+        raise MeasuringError(alarms.KNUM_DIGIT5, f"_KNUM={n}: 5th digit {d5} must be 0 or 1")
+    if d6 not in (0, 1, 2, 3, 4):
+        raise MeasuringError(alarms.KNUM_DIGIT6, f"_KNUM={n}: 6th digit {d6} must be 0..4")
+    if d7 not in (0, 1, 2, 3):
+        raise MeasuringError(alarms.KNUM_DIGIT7, f"_KNUM={n}: 7th digit {d7} must be 0..3")
+    return d4, d5, d6, d7
+
+
+def _dl_number(n: int, d7: int, dlnum: int) -> int:
+    """_DLNUM: 1..6 where digit 7 asks for a setup/sum offset, else 0..6 and not used (61406)."""
+    if d7 in (1, 3):
+        if isinstance(dlnum, bool) or int(dlnum) not in range(1, 7):
+            raise MeasuringError(alarms.DL_NUMBER, f"_KNUM={n} needs a setup/sum offset _DLNUM in 1..6, got {dlnum!r}")
+        return int(dlnum)
+    if isinstance(dlnum, bool) or int(dlnum) not in range(0, 7):
+        raise MeasuringError(alarms.DL_NUMBER, f"_DLNUM={dlnum!r} must be 0..6")
+    return 0
+
+
 def decode_tool_knum(knum: float | str, *, tnum: int = 0, tname: str = "", dlnum: int = 0, tenv: str = "",
                      geometry: bool = False, setup: bool = False) -> ToolTarget | None:
     """_KNUM (7-digit layout, MM turning §2.3) -> ToolTarget; 0 -> None (measure only).
@@ -144,27 +169,13 @@ def decode_tool_knum(knum: float | str, *, tnum: int = 0, tname: str = "", dlnum
     if n < 0 or n >= 10_000_000:
         raise MeasuringError(alarms.KNUM_DIGIT7, f"_KNUM={knum!r}: 7th and higher digits invalid")
     d = n % 1000
-    d4, d5, d6, d7 = (n // 1000) % 10, (n // 10_000) % 10, (n // 100_000) % 10, (n // 1_000_000) % 10
-    if d4 not in (0, 1, 2):
-        raise MeasuringError(alarms.KNUM_DIGIT4, f"_KNUM={n}: 4th digit {d4} must be 0, 1 or 2")
-    if d5 not in (0, 1):
-        raise MeasuringError(alarms.KNUM_DIGIT5, f"_KNUM={n}: 5th digit {d5} must be 0 or 1")
-    if d6 not in (0, 1, 2, 3, 4):
-        raise MeasuringError(alarms.KNUM_DIGIT6, f"_KNUM={n}: 6th digit {d6} must be 0..4")
-    if d7 not in (0, 1, 2, 3):
-        raise MeasuringError(alarms.KNUM_DIGIT7, f"_KNUM={n}: 7th digit {d7} must be 0..3")
+    d4, d5, d6, d7 = _knum_digits(n)
     env = d7 in (2, 3)
     if d == 0 and not env:
         raise MeasuringError(alarms.D_NUMBER, f"_KNUM={n}: the D number is 0")
     if env and not str(tenv or "").strip():
         raise MeasuringError(alarms.TOOL_ENVIRONMENT, f"_KNUM={n} needs a tool environment _TENV")
-    dl = 0
-    if d7 in (1, 3):
-        if isinstance(dlnum, bool) or int(dlnum) not in range(1, 7):
-            raise MeasuringError(alarms.DL_NUMBER, f"_KNUM={n} needs a setup/sum offset _DLNUM in 1..6, got {dlnum!r}")
-        dl = int(dlnum)
-    elif isinstance(dlnum, bool) or int(dlnum) not in range(0, 7):
-        raise MeasuringError(alarms.DL_NUMBER, f"_DLNUM={dlnum!r} must be 0..6")
+    dl = _dl_number(n, d7, dlnum)
     if not env and int(tnum or 0) <= 0 and not str(tname or "").strip():
         raise MeasuringError(alarms.TOOL_NUMBER, "no tool to correct: _TNUM = 0 and no _TNAME")
     quantity = {0: "radius" if d4 == 2 else "length", 1: "l1", 2: "l2", 3: "l3", 4: "radius"}[d6]

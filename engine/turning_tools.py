@@ -111,19 +111,23 @@ def decode_982(mvar: object, cycle: int = 982) -> Variant982:
     if cycle not in (972, 982):
         raise ValueError(f"cycle must be 972 or 982, got {cycle!r}")
     d = [(n // 10 ** i) % 10 for i in range(6)]
-    ok = d[0] in (0, 1, 2) and d[1] in (0, 1) and d[2] in (0, 1) and d[4] in (0, 1) and d[5] in (0, 1)
-    if ok and d[0] == 0:
-        ok = d[2] == d[3] == d[4] == 0                       # calibration: no mill digits
-    if ok and d[0] == 1:
-        ok = d[3] in (0, 1, 2)
-    if ok and d[0] == 2:
-        ok = d[3] in (0, 3, 4) and d[5] == 0                 # 1xxxx2 not incremental
-    if ok and d[5] == 1:
-        ok = d[3] in (0, 1)                                  # 102xx1, 112xx1 not incremental
-    if not ok:
+    if not _digits_982_valid(d):
         raise MeasuringError(alarms.WRONG_VARIANT, f"_MVAR={n} is not a CYCLE982 variant (turning.md §3.1)")
     return Variant982(kind=("calibrate", "measure", "auto")[d[0]], workpiece=d[1] == 1, reversal=d[2] == 1,
                       d4=d[3], radial=d[4] == 1, incremental=d[5] == 1)
+
+
+def _digits_982_valid(d: list[int]) -> bool:
+    """The digit rules of _MVAR (units first) [L17611–L17614]."""
+    if not (d[0] in (0, 1, 2) and d[1] in (0, 1) and d[2] in (0, 1) and d[4] in (0, 1) and d[5] in (0, 1)):
+        return False
+    if d[0] == 0 and not d[2] == d[3] == d[4] == 0:          # calibration: no mill digits
+        return False
+    if d[0] == 1 and d[3] not in (0, 1, 2):
+        return False
+    if d[0] == 2 and not (d[3] in (0, 3, 4) and d[5] == 0):  # 1xxxx2 not incremental
+        return False
+    return not (d[5] == 1 and d[3] not in (0, 1))             # 102xx1, 112xx1 not incremental
 
 
 def tool_probe_record(call: Cycle982, variant: Variant982, ctx: LatheContext) -> tuple[int, Mapping[str, float]]:
@@ -160,28 +164,38 @@ def check_982(call: Cycle982, ctx: LatheContext) -> tuple[Variant982, LatheTool]
             raise MeasuringError(alarms.CUTTING_EDGE_POSITION,
                                  f"the calibration tool must have SL 3, got SL {tool.sl} [L16622–L16630]")
     elif family == "turning":
-        if variant.reversal or variant.d4 or variant.radial:
-            raise MeasuringError(alarms.WRONG_VARIANT, f"_MVAR={call.mvar}: mill digits with a turning tool")
-        if tool.sl not in range(1, 9):
-            raise MeasuringError(alarms.CUTTING_EDGE_POSITION, f"a turning tool needs SL 1..8, got {tool.sl}")
+        _check_turning_tool(call, variant, tool)
     else:
-        if drill_applicate:
-            if variant.kind == "auto" or variant.d4 or variant.reversal:
-                raise MeasuringError(alarms.WRONG_VARIANT, f"_MVAR={call.mvar}: a drill with SD 42950=0 is "
-                                                           "measured with 1, 11 or 1000x1 only (turning.md §3.4)")
-        elif ctx.tool_length_type != 2:
-            raise MeasuringError(alarms.TOOL_TYPE, "mills and drills on a lathe need SD 42950 "
-                                                   "TOOL_LENGTH_TYPE=2 (turning.md §3.1)")
-        if ctx.bit(20):
-            if not (variant.kind == "measure" and not variant.reversal and variant.d4 in (0, 1)):
-                raise MeasuringError(alarms.WRONG_VARIANT, f"_MVAR={call.mvar} is not allowed with _CHBIT[20]=1 "
-                                                           "(only xxx0x1, [L17615–L17618])")
-        elif not ctx.spos:
-            raise MeasuringError(alarms.NEEDS_SPOS, "measuring a milling tool needs an SPOS-capable spindle")
-        if variant.d4 in (3, 4):
-            raise MeasuringError(alarms.WRONG_VARIANT, f"_MVAR={call.mvar}: the upper-edge variants (digit 4 = 3/4) "
-                                                       "are not supported by this product")
+        _check_mill_rules(call, variant, ctx, drill_applicate)
     return variant, tool
+
+
+def _check_turning_tool(call: Cycle982, variant: Variant982, tool: LatheTool) -> None:
+    """A turning tool: no mill digits in _MVAR, SL 1..8 (turning.md §1.2)."""
+    if variant.reversal or variant.d4 or variant.radial:
+        raise MeasuringError(alarms.WRONG_VARIANT, f"_MVAR={call.mvar}: mill digits with a turning tool")
+    if tool.sl not in range(1, 9):
+        raise MeasuringError(alarms.CUTTING_EDGE_POSITION, f"a turning tool needs SL 1..8, got {tool.sl}")
+
+
+def _check_mill_rules(call: Cycle982, variant: Variant982, ctx: LatheContext, drill_applicate: bool) -> None:
+    """Mills and drills on a lathe (turning.md §3.1, §3.4): SD 42950, _CHBIT[20] or SPOS, digit 4."""
+    if drill_applicate:
+        if variant.kind == "auto" or variant.d4 or variant.reversal:
+            raise MeasuringError(alarms.WRONG_VARIANT, f"_MVAR={call.mvar}: a drill with SD 42950=0 is "
+                                                       "measured with 1, 11 or 1000x1 only (turning.md §3.4)")
+    elif ctx.tool_length_type != 2:
+        raise MeasuringError(alarms.TOOL_TYPE, "mills and drills on a lathe need SD 42950 "
+                                               "TOOL_LENGTH_TYPE=2 (turning.md §3.1)")
+    if ctx.bit(20):
+        if not (variant.kind == "measure" and not variant.reversal and variant.d4 in (0, 1)):
+            raise MeasuringError(alarms.WRONG_VARIANT, f"_MVAR={call.mvar} is not allowed with _CHBIT[20]=1 "
+                                                       "(only xxx0x1, [L17615–L17618])")
+    elif not ctx.spos:
+        raise MeasuringError(alarms.NEEDS_SPOS, "measuring a milling tool needs an SPOS-capable spindle")
+    if variant.d4 in (3, 4):
+        raise MeasuringError(alarms.WRONG_VARIANT, f"_MVAR={call.mvar}: the upper-edge variants (digit 4 = 3/4) "
+                                                   "are not supported by this product")
 
 
 # --- direction from the start position (turning.md §1.3, turning §2.3) -------------------------------

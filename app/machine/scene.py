@@ -457,6 +457,36 @@ def build_scene(scenario, table_angle: float = 0.0) -> Scene:
     return Scene(bodies)
 
 
+def _base_outline(out: dict, base, place, axis: list[float]) -> None:
+    """The block's corners or the prism's polygon (top and bottom) into ``out``."""
+    if base is not None and base.type == "block":
+        lx, ly, lz = base.size
+        out["block"] = {"corners": [place(x, y, z) for z in (0.0, -lz) for x, y in
+                                    ((0, 0), (lx, 0), (lx, ly), (0, ly))]}
+    elif base is not None:
+        polygon = base.ccw_polygon
+        out["prism"] = {"kind": "prism", "top": [place(x, y, 0.0) for x, y in polygon],
+                        "bottom": [place(x, y, -base.height) for x, y in polygon],
+                        "axis": axis, "height": float(base.height)}
+
+
+def _feature_outline(out: dict, f, place, axis: list[float]) -> None:
+    """A hole/spigot (circle), pocket/boss (rect) or sphere into ``out``."""
+    if f.type in ("hole", "spigot"):
+        top = 0.0 if f.type == "hole" else f.height
+        height = f.depth if f.type == "hole" else f.height
+        out["circles"].append({"kind": f.type, "center": place(f.center[0], f.center[1], top),
+                               "axis": axis, "diameter": f.diameter, "height": height})
+    elif f.type in ("pocket", "boss"):
+        top = 0.0 if f.type == "pocket" else f.height
+        hx, hy = f.size[0] / 2, f.size[1] / 2
+        cx, cy = f.center
+        out["rects"].append({"kind": f.type, "corners": [
+            place(cx + sx * hx, cy + sy * hy, top) for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))]})
+    elif f.type == "sphere":
+        out["spheres"].append({"kind": "sphere", "center": place(*f.center), "diameter": float(f.diameter)})
+
+
 def outline(scenario, table_angle: float = 0.0) -> dict:
     """The true solids for the machine view (JSON-ready, MCS): block corners, circles, rects,
     the prism's polygon (``prism``: ``top``/``bottom`` vertices counter-clockwise seen from the
@@ -472,31 +502,9 @@ def outline(scenario, table_angle: float = 0.0) -> dict:
             return [float(v) for v in rot @ np.array([x, y, z]) + trans]
 
         axis = [float(v) for v in rot[:, 2]]          # the part's z axis
-        base = wp.base
-        if base is not None and base.type == "block":
-            lx, ly, lz = base.size
-            out["block"] = {"corners": [place(x, y, z) for z in (0.0, -lz) for x, y in
-                                        ((0, 0), (lx, 0), (lx, ly), (0, ly))]}
-        elif base is not None:
-            polygon = base.ccw_polygon
-            out["prism"] = {"kind": "prism", "top": [place(x, y, 0.0) for x, y in polygon],
-                            "bottom": [place(x, y, -base.height) for x, y in polygon],
-                            "axis": axis, "height": float(base.height)}
+        _base_outline(out, wp.base, place, axis)
         for f in wp.features:
-            if f.type in ("hole", "spigot"):
-                top = 0.0 if f.type == "hole" else f.height
-                height = f.depth if f.type == "hole" else f.height
-                out["circles"].append({"kind": f.type, "center": place(f.center[0], f.center[1], top),
-                                       "axis": axis, "diameter": f.diameter, "height": height})
-            elif f.type in ("pocket", "boss"):
-                top = 0.0 if f.type == "pocket" else f.height
-                hx, hy = f.size[0] / 2, f.size[1] / 2
-                cx, cy = f.center
-                out["rects"].append({"kind": f.type, "corners": [
-                    place(cx + sx * hx, cy + sy * hy, top) for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))]})
-            elif f.type == "sphere":
-                out["spheres"].append({"kind": "sphere", "center": place(*f.center),
-                                       "diameter": float(f.diameter)})
+            _feature_outline(out, f, place, axis)
     up = [float(v) for v in spindle_mount(scenario)[:, 2]]
     if scenario.ring_gauge is not None:
         ring = scenario.ring_gauge

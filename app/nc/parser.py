@@ -460,6 +460,9 @@ def refuse_out_of_scope(text: str) -> None:
     """A word of the manual this control does not run (app.nc.scope) names itself, wherever it
     stands in the program, before any other complaint (``CYCLE800(1,““,...)`` of manual §5.7.2):
     what ``Interpreter.load`` checks first; the grammar itself still reads such words."""
+    upper = text.upper()
+    if not any(word in upper for word in OUT_OF_SCOPE):        # the usual case: one pass per word, no regex
+        return
     for number, line in enumerate(text.replace("\r\n", "\n").replace("\r", "\n").split("\n"), start=1):
         if line.lstrip().startswith("%"):
             continue

@@ -41,29 +41,18 @@ def probe_row(probe) -> dict:
 
 
 def seed(db: Database, scenario, reset: bool, tool_probe_number: int) -> None:
+    """The lathe's stored data from the scenario's nominal values: tools, probe record 1, the tool
+    probe's rough triggers, the grooves _KB; ``reset`` clears tools, offsets and records first."""
     with db.unit() as unit:
         if reset:
-            for tool in unit.list_tools():
-                unit.delete_tool(tool["t"])
-            for name in unit.offset_names():
-                unit.put_offset(name, {"trans": {}, "fine": {}, "rot": {}}, source="scenario",
-                                detail={"reason": "reset_data"})
-            for record in unit.list_probes():
-                unit.put_probe(record["number"], {})
-            for record in unit.list_tool_probes():
-                unit.put_tool_probe(record["number"], {})
-            unit.set_state("tool", None)
+            _clear(unit)
         present = {tool["t"] for tool in unit.list_tools()}
         if scenario.probe.t not in present:
             unit.put_tool(scenario.probe.t, probe_row(scenario.probe))
         for tool in scenario.tools:
             if tool.t not in present:
                 unit.put_tool(tool.t, tool_row(tool))
-        probe = unit.get_probe(1) or {}
-        if reset or not any(r.get("tool") == scenario.probe.t for r in unit.list_probes()):
-            if not probe.get("tool"):
-                unit.put_probe(1, {**probe, "number": 1, "tool": scenario.probe.t,
-                                   "ball_diameter": scenario.probe.nominal_value("ball_diameter")})
+        _seed_probe_record(unit, scenario, reset)
         if scenario.tool_probe is not None:
             n = 1 if reset else int(tool_probe_number)
             record = unit.get_tool_probe(n) or {}
@@ -74,6 +63,29 @@ def seed(db: Database, scenario, reset: bool, tool_probe_number: int) -> None:
             records = [g.kb() for g in scenario.grooves][:GROOVE_RECORDS]
             records += [{} for _ in range(GROOVE_RECORDS - len(records))]
             unit.set_state(STATE_GROOVES, records)
+
+
+def _clear(unit) -> None:
+    """reset_data: no tools, zero offsets, empty probe and tool-probe records, no tool in the spindle."""
+    for tool in unit.list_tools():
+        unit.delete_tool(tool["t"])
+    for name in unit.offset_names():
+        unit.put_offset(name, {"trans": {}, "fine": {}, "rot": {}}, source="scenario",
+                        detail={"reason": "reset_data"})
+    for record in unit.list_probes():
+        unit.put_probe(record["number"], {})
+    for record in unit.list_tool_probes():
+        unit.put_tool_probe(record["number"], {})
+    unit.set_state("tool", None)
+
+
+def _seed_probe_record(unit, scenario, reset: bool) -> None:
+    """Probe record 1 names the scenario's probe unless a record does already (or after a reset)."""
+    probe = unit.get_probe(1) or {}
+    if reset or not any(r.get("tool") == scenario.probe.t for r in unit.list_probes()):
+        if not probe.get("tool"):
+            unit.put_probe(1, {**probe, "number": 1, "tool": scenario.probe.t,
+                               "ball_diameter": scenario.probe.nominal_value("ball_diameter")})
 
 
 # --- reference grooves _KB ------------------------------------------------------------------------

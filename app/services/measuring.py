@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import copy
+import math
 
 from pydantic import ValidationError
 
 from app.access.checks import check_actor
-from app.errors import InvalidInput
+from app.errors import AlarmError, InvalidInput
 from app.machine.protocol import Alarm, KinematicData, Machine
 from app.machine.scenario import Scenario
 from app.records import ToolData, frame_out_of_range, is_probe_tool
@@ -71,6 +72,17 @@ def lathe_records(unit) -> dict:
             "memories": {"EV": unit.list_memories("EV"), "MV": unit.list_memories("MV")}}
 
 
+TILT_TASK = "plane.align"        # orient plane (jog-measuring §6): its frame turns about X/Y
+
+
+def tilt_deg(frame: dict) -> float:
+    """The angle between a frame's Z and the machine's Z, from its rotation about X and Y (degrees;
+    RPY: cos(tilt) = cos(rx)·cos(ry))."""
+    rot = frame.get("rot") or {}
+    rx, ry = math.radians(float(rot.get("X", 0.0))), math.radians(float(rot.get("Y", 0.0)))
+    return math.degrees(math.acos(max(-1.0, min(1.0, math.cos(rx) * math.cos(ry)))))
+
+
 class MeasuringEnv:
     """Implements ``app.workflow.service.WorkflowEnv`` with the app's services."""
 
@@ -81,10 +93,22 @@ class MeasuringEnv:
         self._cache: tuple | None = None
         self._start_actor: Actor | None = None      # who pressed NC Start (for a measurement that runs on in a thread)
         self.results: ResultsService | None = None   # links log entries to the job's part (design.md §10.3)
+        # issue 34 §5: a tilt "orient plane" measured that the NC refused to hold (LinuxCNC: no rotation
+        # about X/Y): (target, tilt in degrees) until an orient plane is stored again
+        self._unaligned_tilt: tuple[str, float] | None = None
 
     @property
     def machine(self) -> Machine:
         return self._ms.machine
+
+    def unaligned_tilt_warning(self) -> str | None:
+        """The warning for a measurement in the machine's plane while the part is tilted and the NC
+        could not hold the orient-plane frame (issue 34 §5): its result is off by the tilt."""
+        if self._unaligned_tilt is None:
+            return None
+        target, tilt = self._unaligned_tilt
+        return (f"Tilted part: orient plane measured {tilt:.3f}° for {target}, which the control cannot hold "
+                "(61321): a measurement in the machine's plane is off by the tilt; align the part on the table")
 
     def interlock(self, action: str) -> None:
         self._ms.interlock(action)
@@ -204,7 +228,14 @@ class MeasuringEnv:
                     raise InvalidInput(f"The measured correction would make {offset.target} {wrong[1]}: "
                                        "check the setpoints and the probe data", field=wrong[0],
                                        code="correction_out_of_range")
-                self._ms.check_holds(offset.target, outcome.after)
+                try:
+                    self._ms.check_holds(offset.target, outcome.after)
+                except AlarmError:
+                    if entry.get("task") == TILT_TASK:
+                        self._unaligned_tilt = (offset.target, tilt_deg(outcome.after))
+                    raise
+                if entry.get("task") == TILT_TASK:
+                    self._unaligned_tilt = None
                 _before, after = unit.put_offset(offset.target, outcome.after, source="measure",
                                                  detail=outcome.detail)
                 stored_offset = (offset.target, after)
@@ -215,13 +246,16 @@ class MeasuringEnv:
                 if outcome.after is not None:
                     tool_update = (outcome.tool, outcome.after)
             if probe_update is not None:
-                unit.put_probe(probe_update[0], probe_update[1], source=source, detail=detail)
+                record = self._calibrated(unit, "workpiece", probe_update[0], probe_update[1], entry)
+                unit.put_probe(probe_update[0], record, source=source, detail=detail)
             if tool_update is not None:
                 stored_tool = unit.put_tool(tool_update[0], tool_update[1], source=source, detail=detail)
             if tool_probe_update is not None:
-                unit.put_tool_probe(tool_probe_update[0], tool_probe_update[1], source=source, detail=detail)
+                record = self._calibrated(unit, "tool", tool_probe_update[0], tool_probe_update[1], entry)
+                unit.put_tool_probe(tool_probe_update[0], record, source=source, detail=detail)
             log_id = self.results.add_log(unit, entry) if self.results is not None else unit.add_log(entry)
             lines = self._kinematics_audit(unit, kinematics_update, log_id)
+        log_entry["calibration_id"] = entry.get("calibration_id")     # a calibration's new id, for the answer
         if lines is not None:                  # the NC holds what the audit says
             machine = self._ms.machine
             assert isinstance(machine, KinematicData), "kinematic_facts found the lines on this machine"
@@ -234,6 +268,17 @@ class MeasuringEnv:
             self._ms.write_tool(stored_tool["t"], stored_tool)
             self._ms.refresh_tool_offset()
         return log_id, outcome
+
+    def _calibrated(self, unit, probe: str, n: int, record: dict, entry: dict) -> dict:
+        """A calibration written: a new calibration id (its probe_events row), valid again, the
+        probe it was made with (design.md §10.4); the log entry carries the new id."""
+        data = {k: record.get(k) for k in ("calibrated_at", "calibrated_length", "calibrated_radius",
+                                           "calibrated_diameter", "trigger", "effective_diameter",
+                                           "measured_ball_diameter") if k in record}
+        event = unit.add_probe_event(probe, n, "calibration", {**data, "task": entry.get("task")})
+        entry["calibration_id"] = event["id"]
+        return {**record, "calibration_id": event["id"], "invalidated": None,
+                "probe_identity": self._ms.probe_identity(probe)}
 
     def _kinematics_audit(self, unit, update: dict | None, log_id: int) -> dict | None:
         """The audit row of a kinematics write (kind "kinematics", undoable); the lines to write."""

@@ -430,6 +430,12 @@ class NcService:
             raise ConflictError(str(exc), code="busy") from None
         self._source, self._text, self._crash = source, text, None
 
+    def user_hook(self, name: str) -> str | None:
+        """CYCLE198 / CYCLE199 (manual §3.2): the stored program of that name, or None."""
+        with self._db.unit(readonly=True) as unit:
+            program = unit.get_program(name)
+        return None if program is None else str(program["text"])
+
     def _program_text(self, name: str) -> str:
         with self._db.unit(readonly=True) as unit:
             program = unit.get_program(name)

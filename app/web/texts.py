@@ -234,6 +234,10 @@ message(r"Input should be (?P<choices>'.*)", N_("Choose %(choices)s"))
 message(r"Not saved: (?P<n>\d+) field\(s\) need correction", N_("Not saved: %(n)s field(s) need correction"))
 message(r"Select an increment \(INC\) for a single jog step", N_("Select an increment (INC) for a single jog step"))
 message(r"Feed override must be 0\.\.120 %", N_("Feed override must be 0..120 %%"))
+message(r"Tilted part: orient plane measured (?P<tilt>[-\d.]+)° for (?P<target>\S+), which the control cannot hold "
+        r"\(61321\): a measurement in the machine's plane is off by the tilt; align the part on the table",
+        N_("Tilted part: orient plane measured %(tilt)s° for %(target)s, which the control cannot hold (61321): a "
+           "measurement in the machine's plane is off by the tilt; align the part on the table"))
 # probe trust (app.workflow.probe_trust): the tail after the alarm text
 message(r"length (?P<axis>\w)-: calibrate the probe length on a known surface first",
         N_("length %(axis)s-: calibrate the probe length on a known surface first"))
@@ -348,3 +352,17 @@ def result_value(key: str, value) -> str:
     if isinstance(value, int | float):
         return format_fixed(value, 4)
     return str(value)
+
+
+# --- soft hyphens in key labels (issue 29 item 3) -----------------------------------------------------
+# Chromium on Linux has no hyphenation dictionaries: a long German compound on a softkey breaks at
+# these joints (a soft hyphen shows "-" only where the line breaks), not at any letter.
+JOINTS = re.compile(r"(?<=\w{4})(?=(verschiebung|ansicht|liste|lungen|taster|speicher|kalibrier|messung|"
+                    r"vorschub|programm|protokoll|korrektur|daten|werte|einrichten|ausrichten|abstand)\b)",
+                    re.IGNORECASE)
+
+
+def breakable(label) -> str:
+    """``label`` with soft hyphens at the joints of its long words (12 letters or more)."""
+    text = str(label)
+    return re.sub(r"\w{12,}", lambda m: JOINTS.sub("\u00ad", m.group(0)), text)

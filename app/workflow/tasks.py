@@ -119,25 +119,14 @@ class TaskSpec:
         params = dict(params or {})
         out = (self.validator or self.engine.validate)(params, plane)
         if "points" in params and not self.circle_points:      # circle tasks: the engine's validator
-            n = params["points"]
-            n = int(n) if isinstance(n, str) and n.strip().isdigit() else n      # typed on a screen
-            if not self.max_points:
-                raise ParamError("points", f"{self.name} has a fixed number of points ({self.points})")
-            if isinstance(n, bool) or not isinstance(n, int) or not self.points <= n <= self.max_points:
-                raise ParamError("points", f"points must be a whole number {self.points}..{self.max_points}, "
-                                 f"got {n!r}")
-            out["points"] = n
+            out["points"] = self._points(params["points"])
         if "max_form_error" in params:
             limit = params["max_form_error"]
             if isinstance(limit, bool) or not isinstance(limit, int | float) or not 0.0 < limit <= 100.0:
                 raise ParamError("max_form_error", "max_form_error must be a number of mm in (0, 100]")
             out["max_form_error"] = float(limit)
         if "verify" in params:
-            if not isinstance(params["verify"], bool):
-                raise ParamError("verify", "verify must be true or false")
-            if params["verify"] and (not self.single_point or self.category != Category.WORKPIECE):
-                raise ParamError("verify", "verify: only single-point workpiece tasks probe again by themselves")
-            out["verify"] = params["verify"]
+            out["verify"] = self._verify(params["verify"])
         if "measurements" in params:
             n = params["measurements"]
             if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MAX_MEASUREMENTS:
@@ -149,6 +138,24 @@ class TaskSpec:
                 raise ParamError("tolerance", "tolerance is an object, for the tasks that correct tools")
             out["tolerance"] = dict(params["tolerance"])
         return out
+
+    def _points(self, n) -> int:
+        """``points``: how many points a task with a variable count probes."""
+        n = int(n) if isinstance(n, str) and n.strip().isdigit() else n      # typed on a screen
+        if not self.max_points:
+            raise ParamError("points", f"{self.name} has a fixed number of points ({self.points})")
+        if isinstance(n, bool) or not isinstance(n, int) or not self.points <= n <= self.max_points:
+            raise ParamError("points", f"points must be a whole number {self.points}..{self.max_points}, "
+                             f"got {n!r}")
+        return n
+
+    def _verify(self, verify) -> bool:
+        """``verify``: a single-point workpiece task probes again by itself."""
+        if not isinstance(verify, bool):
+            raise ParamError("verify", "verify must be true or false")
+        if verify and (not self.single_point or self.category != Category.WORKPIECE):
+            raise ParamError("verify", "verify: only single-point workpiece tasks probe again by themselves")
+        return verify
 
     def program(self, params: dict, n: int, start, ctx: PlanContext):
         if not 1 <= int(n) <= self.points_of(params):

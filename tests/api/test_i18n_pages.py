@@ -1,6 +1,6 @@
 """Languages and units of the screens (issue 17 items 1-2, design.md §9.9).
 
-The Chinese texts are the manual's (seed 001 §4.2/4.3: 测量工件, 测量棱边, 设置棱边, 校正测量头,
+The Chinese texts are the manual's (seed 001 §4.2/4.3: 测量工件, 测量棱边, 设置棱边, 匹配测量头,
 NC 启动, 测量头未接通), the German ones Operate's. Inch: 1 inch = 25.4 mm exactly (ISO 31), typed
 on a screen, read back in mm through the JSON API (its contract stays mm and English).
 """
@@ -78,7 +78,7 @@ def test_jog_screen_in_chinese_and_german(client):
 
 def test_measuring_menus_and_screen_in_chinese(client):
     menu = client.get("/measure/workpiece?lang=zh").text
-    for text in ("测量棱边 &gt;", "测量转角 &gt;", "测量槽/钻孔 &gt;", "测量轴颈 &gt;", "校准平面", "校正测量头 &gt;", "返回"):
+    for text in ("测量棱边 &gt;", "测量转角 &gt;", "测量槽/钻孔 &gt;", "测量轴颈 &gt;", "矫正平面", "匹配测量头 &gt;", "返回"):
         assert text in menu, text
     edge = client.get("/measure/workpiece/edge?lang=zh").text
     assert "设置棱边" in edge and "校准棱边" in edge and "2 棱边间距" in edge

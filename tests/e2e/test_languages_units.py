@@ -25,7 +25,7 @@ INCH = 25.4
 CYCLE_MS = 30000        # a calibration runs in the background; the machine is shared
 
 TEXTS = {
-    "zh": {"measure": "测量工件", "calibrate": "校正测量头", "radius": "半径", "edge": "测量棱边",
+    "zh": {"measure": "测量工件", "calibrate": "匹配测量头", "radius": "半径", "edge": "测量棱边",
            "set_edge": "设置棱边", "done": "测量完成", "back": "返回", "nc_start": "NC 启动",
            "diameter": "校准环直径", "written": "已写入，未激活",
            "inactive": "您在一个未激活的 NV 中补偿！"},

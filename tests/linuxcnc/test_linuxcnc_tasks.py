@@ -14,6 +14,9 @@ the rotary-axis correction (hole.2 with C) needs a rotary axis the configuration
 
 from __future__ import annotations
 
+import math
+import re
+
 import pytest
 import test_tasks_truth as truth
 from conftest import linuxcnc_client
@@ -71,3 +74,11 @@ def test_the_tilted_plane_is_refused_and_linuxcnc_keeps_its_g54(tmp_path):
         alarms = client.get("/api/machine").json()["alarms"]
         assert any(a["code"] == 61321 for a in alarms)
         print(f"\nrefused: {error}; the HMI's stored G54 afterwards: {op.offset('G54')['rot']}")
+        # issue 34 §5: the part stays tilted; a measurement in the machine's plane now warns
+        assert client.post("/api/machine/reset").status_code == 200
+        edge = op.create("edge.set", {"axis": "Z", "direction": "-", "setpoint": {"Z": 0.0}}, "G54")
+        op.ball_to(op.part.mcs(60.0, 20.0, 8.0))
+        started = op.start(edge["id"])
+        tilt = math.degrees(math.acos(math.cos(math.radians(0.6)) * math.cos(math.radians(-0.4))))   # the part's
+        warned = [re.match(r"Tilted part: orient plane measured ([\d.]+)° for G54", w) for w in started["warnings"]]
+        assert [float(m.group(1)) for m in warned if m] == [pytest.approx(tilt, abs=0.002)]

@@ -786,9 +786,9 @@ class LinuxCncMachine:
     def change_tool(self, tool: int | None, offset_length: float) -> None:
         offset_length = finite(offset_length, "offset_length")
         if self._own is not None:
-            if tool is not None and tool not in self._tools:
-                raise MachineAlarm(self._raise(Alarm.of(alarms.NO_TOOL_FOR_IDENTIFIER, f"No tool for the given tool "
-                                                        f"identifier: T{tool} is not in LinuxCNC's tool table")))
+            if tool is not None and tool not in self._tools:       # refused, nothing changed: no lasting alarm
+                raise MachineAlarm(Alarm.of(alarms.NO_TOOL_FOR_IDENTIFIER, f"No tool for the given tool "
+                                            f"identifier: T{tool} is not in LinuxCNC's tool table"))
         elif tool is not None and tool != self._scenario.probe.t and self._scenario.tool(tool) is None:
             raise MachineAlarm(self._raise(Alarm.of(alarms.NO_TOOL_FOR_IDENTIFIER, f"No tool for the given tool "
                                                     f"identifier: T{tool} is not in the magazine")))

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from app.nc.cycles import calibration, kinematics, protocol, sphere, workpiece
 from app.nc.cycles.base import CycleHost, NcMeasuring
+from app.nc.cycles.hooks import hooked
 
 CYCLE_NAMES = ("CYCLE976", "CYCLE977", "CYCLE978", "CYCLE979", "CYCLE998", "CYCLE961", "CYCLE997", "CYCLE971")
 # logging measuring results (manual §7.1): registered when the host keeps protocol files
@@ -20,6 +21,8 @@ PROTOCOL_CYCLES = ("CYCLE100", "CYCLE101", "CYCLE105", "CYCLE106", "CYCLE113", "
 
 def measuring_cycles(host: CycleHost) -> dict:
     handlers = {**workpiece.handlers(host), **sphere.handlers(host), **calibration.handlers(host)}
+    if hasattr(host, "user_hook"):             # CYCLE198 / CYCLE199 around every measuring cycle (manual §3.2)
+        handlers = {name: hooked(host, handler) for name, handler in handlers.items()}  # type: ignore[arg-type]
     product = kinematics.handlers(host)     # CYCLE996-like (design.md §10.6): a product cycle, no form
     if getattr(host, "protocol_files", None) is None:
         return {**{name: handlers[name] for name in CYCLE_NAMES}, **product}
