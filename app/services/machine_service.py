@@ -24,6 +24,7 @@ With a swivel head turned out of +Z the length goes along the machine's actual t
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import json
 import logging
 import threading
@@ -121,6 +122,10 @@ class MachineService:
         self._hold = HoldToRun(machine)
         self._frames: tuple[int, dict[str, Frame]] | None = None
         self._discard_listeners: list[Callable[[str], None]] = []
+        # probe health (design.md §10.4): alarms as they appear, scenario loads
+        self._alarm_listeners: list[Callable[[Alarm, dict], None]] = []
+        self._alarms_seen: frozenset[tuple[int, str, bool]] = frozenset()
+        self._scenario_listeners: list[Callable[[], None]] = []
         # one channel (issue 24 §3-4): what a Reset ends, what the mode group refuses, NC Stop's hold
         self._reset_listeners: list[tuple[Callable[[], None], Callable[[], None]]] = []
         self._interlocks: list[Callable[[str], None]] = []
@@ -225,6 +230,7 @@ class MachineService:
         of changed (the machine's status, mode, lock, offset, chain, plane, feed hold), so that
         polls and the live feed cost no frame arithmetic and no encoding at rest (issue 30)."""
         st = self._machine.status()
+        self._see_alarms(st)
         settings = self._settings.get()
         plane, units = settings.plane, settings.units
         mode = (self.mode_source() if self.mode_source else None) or st.mode
@@ -271,6 +277,41 @@ class MachineService:
             **self._probe_status(st),
             **(self._lathe_status(st) if self.is_lathe else {}),
         }
+
+    def on_alarm(self, listener: Callable[[Alarm, dict], None]) -> None:
+        """``listener(alarm, probes)`` once for each alarm that appears (``probes``: ``{"probe",
+        "tool_probe", "tool"}`` when it was seen). Seen on every status read and before a Reset or
+        a scenario load clears the alarms, so no alarm goes unseen (design.md §10.4)."""
+        self._alarm_listeners.append(listener)
+
+    def on_scenario(self, listener: Callable[[], None]) -> None:
+        """``listener()`` after a scenario load (another probe may be in the machine now)."""
+        self._scenario_listeners.append(listener)
+
+    def _see_alarms(self, st: MachineStatus | None = None) -> None:
+        if not self._alarm_listeners:
+            return
+        st = st or self._machine.status()
+        now = frozenset((a.code, a.text, a.resettable) for a in st.alarms)
+        with self._lock:
+            new = now - self._alarms_seen
+            self._alarms_seen = now
+        if not new:
+            return
+        probes = {**self._probe_status(st), "tool": st.tool}
+        for alarm in sorted(st.alarms, key=lambda a: a.resettable):      # the graver (a broken probe) first
+            if (alarm.code, alarm.text, alarm.resettable) in new:
+                for listener in self._alarm_listeners:
+                    listener(alarm, probes)
+
+    def probe_identity(self, which: str = "workpiece") -> str | None:
+        """A fingerprint of the scenario's probe (the tool probe: ``which="tool"``): what a real
+        control knows as the probe's serial number; None when there is no such probe."""
+        part = self._scenario.probe if which == "workpiece" else getattr(self._scenario, "tool_probe", None)
+        if part is None:
+            return None
+        text = json.dumps(part.model_dump(mode="json", exclude={"radio"}), sort_keys=True)
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
 
     def probe_status(self) -> dict:
         """``{"probe", "tool_probe"}`` of ``status()``, read alone (the probe test samples it)."""
@@ -547,6 +588,7 @@ class MachineService:
         runners are told to stop, the motion stops, the runners end (program reset to its
         defaults, measurement aborted), feed hold ends, the resettable alarms are cleared."""
         self._hold.release()
+        self._see_alarms()                      # a collision is seen before Reset clears it
         for stop, _wait in self._reset_listeners:
             stop()
         self._machine.reset()
@@ -744,6 +786,7 @@ class MachineService:
         self.interlock("scenario")
         self._ensure_idle()
         self._hold.release()
+        self._see_alarms()
         with self._lock:
             if getattr(scenario, "kind", "mill") != getattr(self._scenario, "kind", "mill"):
                 self._switch_machine(scenario)
@@ -758,6 +801,8 @@ class MachineService:
                 tool = unit.get_state(STATE_TOOL, None)
             self._restore_tool(tool)
         self._discard("A scenario was loaded")
+        for listener in self._scenario_listeners:
+            listener()
         return self.status()
 
     def _switch_machine(self, scenario: Scenario | LatheScenario) -> None:

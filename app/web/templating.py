@@ -151,6 +151,7 @@ templates.env.globals["result_value"] = texts.result_value
 templates.env.globals["source_text"] = texts.source_text
 templates.env.globals["log_status_text"] = texts.log_status_text
 templates.env.filters["label_text"] = texts.label_text
+templates.env.filters["breakable"] = texts.breakable          # soft hyphens in long key labels
 templates.env.globals["say"] = texts.translate_message      # a service's message in the operator's words
 templates.env.filters["say"] = texts.translate_message
 templates.env.globals["HORIZONTAL_SOFTKEYS"] = HORIZONTAL_SOFTKEYS
