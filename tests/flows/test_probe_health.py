@@ -69,7 +69,7 @@ def test_bad_input_and_no_face_store_nothing(tmp_path):
             error = _repeatability(flow, status=422, **body)["error"]
             assert error["field"] == field
         flow.goto(z=SAFE_Z)                                      # nothing below within 10 mm
-        assert _repeatability(flow, status=409)["error"]["code"] == "not_switched"
+        assert _repeatability(flow, status=409, distance=10.0)["error"]["code"] == "not_switched"
         assert ok(client.get("/api/probes/1"))["repeatability"] is None
         assert ok(client.get("/api/probes/1/history")) == []
 
