@@ -49,7 +49,7 @@ HORIZONTAL_SOFTKEYS: list[tuple[str, str, str] | None] = [
 
 # on a lathe (turning.md §10.1) F1 opens the lathe's measuring menu, a product extension; F2 is empty
 LATHE_HORIZONTAL_SOFTKEYS: list[tuple[str, str, str] | None] = [
-    ("measure_lathe", "Measure lathe (ext.)", "measure_lathe_menu"), None, *HORIZONTAL_SOFTKEYS[2:]]
+    ("measure_lathe", N_("Measure turned part"), "measure_lathe_menu"), None, *HORIZONTAL_SOFTKEYS[2:]]
 
 
 def _route_index(app) -> dict:
