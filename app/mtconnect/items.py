@@ -59,13 +59,20 @@ def offsets_table(offsets: dict[str, dict]) -> str:
     return " ".join(entries)
 
 
+def _fault(code: int, text: str) -> str:
+    """A FAULT with the alarm number as native code. The qualifier stays empty: MTConnect allows
+    only HIGH or LOW there (a value above or below its limits), which an NC alarm is not; the
+    native severity stays empty too (the control's alarms carry none)."""
+    return f"{SYSTEM}|FAULT|{code}|||{clean(text)}"
+
+
 def conditions(active: set[tuple[int, str]], before: set[tuple[int, str]] | None) -> list[str]:
     """Condition lines (without timestamp) for the change from ``before`` to ``active``: a FAULT
     for each new alarm, NORMAL with its code for each gone one, a plain NORMAL when none is left."""
     if before is None:                     # a new agent: the whole state
-        lines = [f"{SYSTEM}|FAULT|{code}||ALARM|{clean(text)}" for code, text in sorted(active)]
+        lines = [_fault(code, text) for code, text in sorted(active)]
         return lines or [f"{SYSTEM}|NORMAL||||"]
-    lines = [f"{SYSTEM}|FAULT|{code}||ALARM|{clean(text)}" for code, text in sorted(active - before)]
+    lines = [_fault(code, text) for code, text in sorted(active - before)]
     gone = sorted(before - active)
     if gone and not active:
         lines.append(f"{SYSTEM}|NORMAL||||")

@@ -3,6 +3,7 @@ connect, equal to the JSON API, a jog within a second, the heartbeat, alarms as 
 
 from __future__ import annotations
 
+import re
 import socket
 import threading
 import time
@@ -122,7 +123,7 @@ def test_an_agent_that_connects_before_the_first_read_gets_the_whole_state():
         wait_until(lambda: services.reads >= reads + 2, "the adapter's loop went round (accepting the agent)")
         services.ready.set()
         agent.read_until(lambda: WHOLE_STATE <= agent.values.keys())
-        assert agent.values["system"].startswith("FAULT|61302|")
+        assert agent.values["system"] == "FAULT|61302|||collision"
         assert agent.values["woffsets"] == "G54={X=2.0000}" and agent.values["Xact"] == "1.0000"
         agent.close()
     finally:
@@ -176,8 +177,27 @@ def test_a_g54_write_reaches_the_offsets_table(shdr):
 def test_conditions_name_each_new_alarm_and_each_gone_one():
     assert conditions(set(), None) == ["system|NORMAL||||"]
     raised = conditions({(20070, "limit")}, set())
-    assert raised == ["system|FAULT|20070||ALARM|limit"]
+    assert raised == ["system|FAULT|20070|||limit"]
     both = {(20070, "limit"), (61303, "probe")}
     assert conditions({(61303, "probe")}, both) == ["system|NORMAL|20070|||"]
     assert conditions(set(), {(61303, "probe")}) == ["system|NORMAL||||"]
     assert offsets_table({"G54": {"trans": {"X": 1.0}, "fine": {"X": 0.5}, "rot": {"Z": 0.0}}}) == "G54={X=1.5000}"
+
+
+# MTConnect Part 1 (adapter protocol, SHDR): a condition line is
+# <timestamp>|<id>|<level>|<native code>|<native severity>|<qualifier>|<message>, the level one of
+# UNAVAILABLE NORMAL WARNING FAULT, the qualifier empty or HIGH or LOW
+SHDR_CONDITION = re.compile(r"^(?P<id>[^|]+)\|(?P<level>UNAVAILABLE|NORMAL|WARNING|FAULT)\|(?P<code>[^|]*)"
+                            r"\|(?P<severity>[^|]*)\|(?P<qualifier>|HIGH|LOW)\|(?P<message>[^\n]*)$")
+
+
+def test_condition_lines_follow_the_shdr_grammar():
+    active = {(20070, "limit | X+"), (61302, "collision")}
+    lines = conditions(active, None) + conditions(set(), active) + conditions(active, set()) \
+        + conditions({(61302, "collision")}, active)
+    for line in lines:
+        match = SHDR_CONDITION.match(line)
+        assert match, line
+        assert match["message"].count("|") == 0
+    faults = [SHDR_CONDITION.match(line) for line in conditions(active, None)]
+    assert [(m["level"], m["code"], m["qualifier"]) for m in faults] == [("FAULT", "20070", ""), ("FAULT", "61302", "")]
