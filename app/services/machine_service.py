@@ -26,6 +26,7 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import json
+import logging
 import threading
 import time
 from collections.abc import Callable, Mapping
@@ -55,7 +56,7 @@ from app.machine.protocol import (
 )
 from app.machine.scenario import Scenario
 from app.records import PROBE_TOOL_TYPE
-from db import Database
+from db import Database, StorageUnavailable
 from engine.alarms import all_alarms
 from engine.alarms import by_number as alarm_by_number
 from engine.coords import GEOMETRY_AXES, LatheToolTip, ToolTip, head_shift_of, length_axis
@@ -65,6 +66,8 @@ from engine.planes import plane as plane_by_name
 from . import lathe_data
 from .live import ChangeSignal
 from .settings import SettingsService
+
+log = logging.getLogger(__name__)
 
 CHANNEL = "CHAN1"
 MAX_TRAVEL = 10_000.0            # mm; a bigger single move is a typo
@@ -135,15 +138,28 @@ class MachineService:
         with db.unit(readonly=True) as unit:
             active = unit.get_state(STATE_ACTIVE_OFFSET, G500)
             tool = unit.get_state(STATE_TOOL, None)
-        self._seed_data(reset=False)
-        self._take_nc_tools()
+        self._at_start(self._seed_data, False)
+        self._at_start(self._take_nc_tools)
         self._push_nc_data()
+        self._at_start(self._activate_stored, active)
+        self._at_start(self._restore_tool, tool)
+
+    def _activate_stored(self, active: str) -> None:
         try:
             self.activate(active if self._is_settable(active) else G500)
         except AlarmError:                     # a stored frame the NC cannot hold: no offset, alarm shown
             with contextlib.suppress(AlarmError):
                 self.activate(G500)
-        self._restore_tool(tool)
+
+    def _at_start(self, step: Callable[..., object], *args: object) -> None:
+        """A start-up step; on a database that cannot be written (design.md §10.8) what it would
+        store is left out and the HMI starts read only."""
+        try:
+            step(*args)
+        except StorageUnavailable as exc:
+            if not self._db.read_only:
+                raise
+            log.warning("start-up step left out (read-only database): %s", exc)
 
     # --- read-only views ----------------------------------------------------------------
     @property
