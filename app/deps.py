@@ -23,6 +23,7 @@ from app.services import (
 )
 from app.services.plant import PlantService
 from app.services.plc import PlcSimulator
+from app.services.probe_health import ProbeHealthService
 from app.services.probe_test import ProbeTestService
 from app.workflow.service import WorkflowService
 
@@ -55,6 +56,7 @@ NcDep = Annotated[NcService, _part("nc")]
 ProgramsDep = Annotated[ProgramService, _part("programs")]
 PlcDep = Annotated[PlcSimulator, _part("plc")]
 ProbeTestDep = Annotated[ProbeTestService, _part("probe_test")]
+ProbeHealthDep = Annotated[ProbeHealthService, _part("probe_health")]
 ResultsDep = Annotated[ResultsService, _part("results")]
 QualityDep = Annotated[QualityService, _part("quality")]
 PlantDep = Annotated[PlantService, _part("plant")]

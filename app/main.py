@@ -51,6 +51,7 @@ from app.services import (
 from app.services.measuring import MeasuringEnv
 from app.services.plant import PlantService
 from app.services.plc import PlcSimulator
+from app.services.probe_health import ProbeHealthService
 from app.services.probe_test import ProbeTestService
 from app.services.scenarios import read_scenario
 from app.web import web_router
@@ -84,7 +85,7 @@ def build_services(settings: Settings, scenario: Scenario | LatheScenario) -> Se
     services = Services(
         db=db, settings=gud, machine=machine,
         offsets=OffsetService(db, machine), tools=ToolService(db, machine),
-        probes=ProbeService(db), tool_probes=ToolProbeService(db), log=LogService(db),
+        probes=ProbeService(db, gud), tool_probes=ToolProbeService(db, gud), log=LogService(db),
     )
     services.memories = MemoryService(db)
     env = MeasuringEnv(db, machine, gud)
@@ -101,6 +102,7 @@ def build_services(settings: Settings, scenario: Scenario | LatheScenario) -> Se
     services.plc = PlcSimulator(lambda: services.workflow)
     services.plant = PlantService(db, machine.status)
     services.probe_test = ProbeTestService(machine)
+    services.probe_health = ProbeHealthService(db, machine, gud)
     return services
 
 

@@ -95,6 +95,15 @@ class ProbeData(BaseModel):
     # pre-travel turns with the spindle ("probe") or stays with the machine axes ("machine")
     measured_ball_diameter: StrictFloat | None = Field(None, gt=0, le=100)
     pretravel_frame: Literal["probe", "machine"] | None = None
+    # probe health (design.md §10.4): kept by the HMI (a PUT keeps the stored ones, app.services.probes);
+    # ``valid``/``invalid_reason``/``calibration_age_h`` are worked out on each read and ignored when sent
+    calibration_id: StrictInt | None = None        # the calibration's probe_events row
+    probe_identity: str | None = Field(None, max_length=40)    # the scenario probe that was calibrated
+    invalidated: dict | None = None                # {"reason", "at", "text"}: what made it invalid
+    repeatability: dict | None = None              # the last check {"n", "two_sigma", "range", "at", ...}
+    valid: StrictBool | None = None
+    invalid_reason: str | None = None
+    calibration_age_h: float | None = None
 
     # A probe's own physics bounds its data (measuring-math §5.1, measuring-math §5.2): the ball centre switches
     # within one ball diameter of the surface, the stylus is off the spindle axis by at most
@@ -152,6 +161,15 @@ class ToolProbeData(BaseModel):
     calibrated_at: str | None = Field(None, max_length=40)
     # the lathe's _TPW[k] (workpiece-related trigger values, SW 6.3, turning.md §0.7), keyed as trigger
     workpiece_trigger: dict[str, StrictFloat] | None = None
+    # probe health (design.md §10.4): kept by the HMI (a PUT keeps the stored ones, app.services.probes);
+    # ``valid``/``invalid_reason``/``calibration_age_h`` are worked out on each read and ignored when sent
+    calibration_id: StrictInt | None = None        # the calibration's probe_events row
+    probe_identity: str | None = Field(None, max_length=40)    # the scenario probe that was calibrated
+    invalidated: dict | None = None                # {"reason", "at", "text"}: what made it invalid
+    repeatability: dict | None = None              # the last check {"n", "two_sigma", "range", "at", ...}
+    valid: StrictBool | None = None
+    invalid_reason: str | None = None
+    calibration_age_h: float | None = None
 
     @field_validator("trigger")
     @classmethod

@@ -76,7 +76,7 @@ class Server:
             cwd=tree, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         self.startup_cpu = self._wait_up()
 
-    def _wait_up(self, timeout_s: float = 60.0) -> float:
+    def _wait_up(self, timeout_s: float = 300.0) -> float:
         end = time.monotonic() + timeout_s
         while time.monotonic() < end:
             if self.proc.poll() is not None:

@@ -4,6 +4,7 @@ at start-up, default data, units of work (design.md §10.5)."""
 from __future__ import annotations
 
 import functools
+import logging
 import re
 import socket
 import sqlite3
@@ -26,11 +27,13 @@ from db.models import Machine
 from db.repository import Unit, offset_layout, seed_defaults, utc_now
 
 MIGRATIONS_DIR = Path(__file__).resolve().parent / "migrations"
+log = logging.getLogger(__name__)
 
 
 class StorageUnavailable(Exception):
     """The database cannot be opened or written (disk full, read-only file, gone): nothing of the
-    transaction was stored. ``str()`` names the file and the cause."""
+    transaction was stored. ``str()`` names the cause; only the start-up's message (for the one who
+    starts the HMI, never a client's answer) names the file."""
 BUSY_TIMEOUT_MS = 10_000
 MACHINE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,63}")
 # pg_advisory_xact_lock key of migrating and seeding: HMIs starting together take turns
@@ -130,8 +133,9 @@ class Database:
                 "options": f"-c lock_timeout={BUSY_TIMEOUT_MS} -c timezone=UTC", "connect_timeout": 10})
             self._write_engine = self._engine
         try:
-            if self.path is not None:
-                self.path.parent.mkdir(parents=True, exist_ok=True)
+            file = self._sqlite_file()
+            if file is not None:
+                file.parent.mkdir(parents=True, exist_ok=True)
             with self._write_engine.begin() as connection:
                 self._migration_turn(connection)
                 upgrade_to_head(connection, self.machine)
@@ -140,7 +144,57 @@ class Database:
                 seed_defaults(session, self._layout, self._rotary_axes, self.machine)
         except (OSError, DBAPIError) as exc:
             self._engine.dispose()
-            raise StorageUnavailable(f"cannot open the database {self.where}: {_cause(exc)}") from exc
+            if not self._readable_file():
+                raise StorageUnavailable(f"cannot open the database {self.where}: {_cause(exc)}") from exc
+            self._open_read_only(exc)
+
+    # --- a database that can be read but not written (design.md §10.8) ------------------------
+    read_only: str | None = None       # why nothing can be written (None: it can)
+
+    def _sqlite_file(self) -> Path | None:
+        if not self.is_sqlite or self.path is None or str(self.path) in ("", ":memory:"):
+            return None
+        text = str(self.path)
+        return Path(text[len("file:"):]) if text.startswith("file:") else self.path
+
+    def _readable_file(self) -> bool:
+        file = self._sqlite_file()
+        return file is not None and file.is_file()
+
+    def _read_only_connection(self) -> sqlite3.Connection:
+        """A connection that never writes: ``mode=ro``, or ``immutable=1`` where even the WAL's
+        shared-memory file cannot be made (a read-only folder or medium)."""
+        last: sqlite3.Error | None = None
+        for flags in ("mode=ro", "mode=ro&immutable=1"):
+            try:
+                connection = sqlite3.connect(f"file:{self._sqlite_file()}?{flags}", uri=True,
+                                             check_same_thread=False, isolation_level=None)
+                connection.execute("SELECT count(*) FROM sqlite_master").fetchone()
+                return connection
+            except sqlite3.Error as exc:
+                last = exc
+        raise StorageUnavailable(f"cannot read the database {self.where}: {last}")
+
+    def _open_read_only(self, cause: Exception) -> None:
+        """Serve what the file holds, read only: writing units raise StorageUnavailable at once. A
+        file of another schema version or without this machine's rows cannot be served."""
+        try:
+            self._read_only_connection().close()      # readable at all?
+        except StorageUnavailable:
+            raise StorageUnavailable(f"cannot open the database {self.where}: {_cause(cause)}") from cause
+        self._engine = create_engine("sqlite://", creator=self._read_only_connection)
+        event.listen(self._engine, "begin", _begin_transaction)
+        self._write_engine = self._engine
+        with self._engine.connect() as connection:
+            revision = MigrationContext.configure(connection).get_current_revision()
+            known = revision == head_revision() and connection.scalar(
+                select(Machine.name).where(Machine.name == self.machine)) is not None
+        if not known:
+            self._engine.dispose()
+            raise StorageUnavailable(f"cannot open the database {self.where}: it cannot be written "
+                                     f"({_cause(cause)}) and is not ready for this HMI to read")
+        self.read_only = f"the database cannot be written: {_cause(cause)}"
+        log.warning("database %s opened read only: %s", self.where, _cause(cause))
 
     def _migration_turn(self, connection: Connection) -> None:
         """PostgreSQL: HMIs starting at once migrate and seed one after the other (SQLite: BEGIN
@@ -151,6 +205,8 @@ class Database:
     @contextmanager
     def unit(self, readonly: bool = False) -> Iterator[Unit]:
         """One transaction: commits when the block ends normally, rolls back on an exception."""
+        if self.read_only and not readonly:
+            raise StorageUnavailable(self.read_only)
         if readonly:
             with Session(self._engine) as session:  # closing rolls back
                 event.listen(session, "before_flush", _refuse_write)
@@ -164,7 +220,7 @@ class Database:
         # write count rises in the unit's own transaction, so it is raised exactly when the unit's
         # changes become visible, to every process (see ``generation``).
         if not self._write_turn.acquire(timeout=BUSY_TIMEOUT_MS / 1000):
-            raise StorageUnavailable(f"the database {self.where} cannot be written: another write "
+            raise StorageUnavailable(f"the database cannot be written: another write "
                                      f"did not end within {BUSY_TIMEOUT_MS // 1000} s")
         try:
             with Session(self._write_engine, expire_on_commit=False) as session, session.begin():
@@ -176,7 +232,8 @@ class Database:
                 finally:
                     unit.detach()
         except OperationalError as exc:      # disk full, read-only file, I/O error, lock timeout: rolled back
-            raise StorageUnavailable(f"the database {self.where} cannot be written: {_cause(exc)}") from exc
+            log.error("database %s cannot be written: %s", self.where, _cause(exc))
+            raise StorageUnavailable(f"the database cannot be written: {_cause(exc)}") from exc
         finally:
             self._write_turn.release()
 
@@ -194,6 +251,11 @@ class Database:
 
     def _sqlite_generation(self) -> int:
         connection = getattr(self._count_readers, "connection", None)
+        if connection is None and self.read_only:
+            connection = self._read_only_connection()
+            self._count_readers.connection = connection
+            with self._count_lock:
+                self._count_connections.append(connection)
         if connection is None:
             # autocommit: each read is its own transaction and sees every committed write
             connection = sqlite3.connect(str(self.path), isolation_level=None, check_same_thread=False)
@@ -204,18 +266,20 @@ class Database:
         try:
             row = connection.execute(_WRITE_COUNT_SQL, (self.machine,)).fetchone()
         except sqlite3.Error as exc:
-            raise StorageUnavailable(f"the database {self.where} cannot be read: {exc}") from exc
+            raise StorageUnavailable(f"the database cannot be read: {_cause(exc)}") from exc
         return int(row[0] or 0) if row is not None else 0
 
     def report_status(self, status: dict[str, Any]) -> None:
         """This HMI is alive, with ``status`` (alarms, mode, ...) for the plant view: its machines
         row only, outside the write count (no cache need read again for it)."""
+        if self.read_only:          # a read-only HMI reports nothing (its row keeps the last report)
+            return
         try:
             with self._write_engine.begin() as connection:
                 connection.execute(update(Machine).where(Machine.name == self.machine)
                                    .values(last_seen=utc_now(), status=status))
         except OperationalError as exc:
-            raise StorageUnavailable(f"the database {self.where} cannot be written: {_cause(exc)}") from exc
+            raise StorageUnavailable(f"the database cannot be written: {_cause(exc)}") from exc
 
     def offset_names(self) -> list[str]:
         """The configured frames in chain order (fixed when the database is opened)."""
@@ -241,9 +305,14 @@ class Database:
 
 
 def _cause(exc: Exception) -> str:
-    """The driver's own words (e.g. "database or disk is full"), without SQL and parameters."""
+    """The driver's own words (e.g. "database or disk is full"), without SQL, parameters and file
+    paths (an answer to a client never shows where the server keeps its files)."""
     original = getattr(exc, "orig", None) or exc
-    return str(original).splitlines()[0] if str(original) else type(original).__name__
+    text = str(original).splitlines()[0] if str(original) else type(original).__name__
+    return _PATH.sub("<path>", text)
+
+
+_PATH = re.compile(r"(?:[A-Za-z]:)?(?:[\\/][^\s\\/:\"']+){2,}[\\/]?")
 
 
 _WRITE_COUNT_SQL = (f"SELECT {Machine.__table__.c.writes.name} FROM {Machine.__tablename__} "

@@ -239,6 +239,25 @@ class MeasurementLog(Base):
     program: Mapped[str | None] = mapped_column(String(64), nullable=True)   # part program (NC cycle), else None
     block: Mapped[str | None] = mapped_column(String(200), nullable=True)    # the block that called the cycle
     part_id: Mapped[int | None] = mapped_column(ForeignKey("parts.id"), nullable=True)   # the job's part (§10.3)
+    calibration_id: Mapped[int | None] = mapped_column(Integer, nullable=True)   # the probe's calibration (§10.4)
+
+
+class ProbeEvent(Base):
+    """What happened to a probe record (design.md §10.4): a calibration (its row id is the
+    calibration id), a repeatability check, an event that invalidated the calibration."""
+
+    __tablename__ = "probe_events"
+    __table_args__ = (Index("ix_probe_events_record", "machine", "probe", "number", "id"),
+                      CheckConstraint("probe IN ('workpiece', 'tool')", name="ck_probe_events_probe"))
+
+    id: Mapped[int] = mapped_column(primary_key=True)
+    machine: Mapped[str] = machine_column()
+    probe: Mapped[str] = mapped_column(String(16))            # "workpiece" (_WP) | "tool" (_TP)
+    number: Mapped[int] = mapped_column(Integer)
+    time: Mapped[str] = mapped_column(String(40))             # UTC ISO 8601
+    event: Mapped[str] = mapped_column(String(16))            # calibration | repeatability | invalidated
+    calibration_id: Mapped[int | None] = mapped_column(Integer, nullable=True)
+    data: Mapped[Any] = mapped_column(NullableJSON, nullable=True)
 
 
 class Program(Base):

@@ -41,12 +41,13 @@ from db.models import (
 )
 from db.parts import PartsUnit
 from db.plant import PlantUnit
+from db.probe_events import ProbeEventsUnit
 
 CHANNEL = 1
 DEFAULT_PROBE_RECORDS = 3        # _CVAL[0], _CVAL[1]: 3 records each by default
 MAX_EXTRA_SETTABLE = 95          # G505..G599
 LOG_FIELDS = ("task", "params", "raw", "points", "result", "correction", "probe", "target", "status",
-              "measuring_wo", "warnings", "program", "block", "part_id")
+              "measuring_wo", "warnings", "program", "block", "part_id", "calibration_id")
 PROGRAM_TEXT_MAX = 200_000       # characters of one part program
 TOOL_FIELDS = ("t", "name", "type", "length", "radius", "wear", "sl", "l1", "l2")
 LATHE_TOOL_FIELDS = ("sl", "l1", "l2")          # lathe tools only (turning.md §10.2); None = not a lathe value
@@ -141,7 +142,7 @@ def seed_defaults(session: Session, layout: Iterable[OffsetSlot], rotary_axes: I
                 session.add(model(machine=machine, number=number, calibrated_at=None, data={"number": number}))
 
 
-class Unit(PartsUnit, PlantUnit):
+class Unit(PartsUnit, PlantUnit, ProbeEventsUnit):
     """Repository methods of one transaction; all take and return plain JSON-ready values."""
 
     def __init__(self, session: Session, layout: tuple[OffsetSlot, ...], machine: str):

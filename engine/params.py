@@ -177,20 +177,25 @@ def circle_touches(params: dict[str, Any]) -> dict[str, Any]:
         out["points"] = n
     angles = params.get("angles")
     if angles is not None:
-        if not isinstance(angles, list) or not MIN_CIRCLE_POINTS <= len(angles) <= MAX_CIRCLE_POINTS or any(
-                isinstance(a, bool) or not isinstance(a, int | float) or not math.isfinite(a) for a in angles):
-            raise ParamError("angles", f"angles must be a list of {MIN_CIRCLE_POINTS}..{MAX_CIRCLE_POINTS} numbers "
-                             "(degrees)")
-        spread = sorted(float(a) % 360.0 for a in angles)
-        gaps = [b - a for a, b in zip(spread, [*spread[1:], spread[0] + 360.0], strict=True)]
-        if min(gaps) < 1.0 or max(gaps) >= 180.0:
-            raise ParamError("angles", "angles must differ by at least 1° and leave no gap of 180° or more "
-                             "(the circle would not be determined)")
+        _check_circle_angles(angles)
         if "points" in out and out["points"] != len(angles):
             raise ParamError("points", f"points = {out['points']} but {len(angles)} angles are given")
         out["angles"] = [float(a) for a in angles]
         out["points"] = len(angles)
     return out
+
+
+def _check_circle_angles(angles: Any) -> None:
+    """A list of MIN..MAX finite numbers (deg), at least 1° apart, no gap of 180° or more."""
+    if not isinstance(angles, list) or not MIN_CIRCLE_POINTS <= len(angles) <= MAX_CIRCLE_POINTS or any(
+            isinstance(a, bool) or not isinstance(a, int | float) or not math.isfinite(a) for a in angles):
+        raise ParamError("angles", f"angles must be a list of {MIN_CIRCLE_POINTS}..{MAX_CIRCLE_POINTS} numbers "
+                         "(degrees)")
+    spread = sorted(float(a) % 360.0 for a in angles)
+    gaps = [b - a for a, b in zip(spread, [*spread[1:], spread[0] + 360.0], strict=True)]
+    if min(gaps) < 1.0 or max(gaps) >= 180.0:
+        raise ParamError("angles", "angles must differ by at least 1° and leave no gap of 180° or more "
+                         "(the circle would not be determined)")
 
 
 def validate_circles(spigot: bool) -> ParamsValidator:

@@ -428,6 +428,39 @@ def tool_checks(delta: float, call: Cycle982, what: str) -> tuple[bool, AlarmDef
     return True, None
 
 
+def _writable(call: Cycle982, variant: Variant982, deltas: dict[str, float]) -> tuple[list[str], list[AlarmDef]]:
+    """The quantities the tool measuring rule lets write, and its warnings: every _TSA check
+    before anything is written; incremental measuring writes without the rule."""
+    warnings: list[AlarmDef] = []
+    write = []
+    for q, delta in deltas.items():
+        if variant.incremental:
+            write.append(q)
+            continue
+        ok, warning = tool_checks(delta, call, QUANTITY_NAME[q])
+        if ok:
+            write.append(q)
+        if warning:
+            warnings.append(warning)
+    return write, warnings
+
+
+def _written(tool: LatheTool, write: list[str], measured: dict[str, float], ctx: LatheContext,
+             variant: Variant982) -> tuple[dict[str, Any], dict[str, Any]]:
+    """(tool before, tool after) the writes per _CHBIT[3], one quantity after the other."""
+    current = tool
+    before = after = None
+    for q in write:
+        b, a = tool_measure_update(current, q, measured[q], remeasure=ctx.bit(3), incremental=variant.incremental)
+        before = before or b
+        after = a
+        current = LatheTool.from_dict(a)
+    before = before or tool_dict(tool)
+    after = after or tool_dict(tool)
+    after["sl"], after["type"], after["t"], after["d"] = tool.sl, tool.type, tool.t, tool.d
+    return before, after
+
+
 def finish_tool(call: Cycle982, variant: Variant982, tool: LatheTool, measured_values: dict[str, float],
                 ev: float, ctx: LatheContext) -> ToolResult:
     """Checks and writing for measured effective values {"l1"/"l2"/"radius": value} (turning.md
@@ -440,27 +473,8 @@ def finish_tool(call: Cycle982, variant: Variant982, tool: LatheTool, measured_v
         actual = value + ev_value if ctx.bit(5) else value - ev_value
         measured[q] = actual
         deltas[q] = actual - tool.effective(q)
-    warnings: list[AlarmDef] = []
-    write = []
-    for q, delta in deltas.items():                # every _TSA check before anything is written
-        if variant.incremental:
-            write.append(q)
-            continue
-        ok, warning = tool_checks(delta, call, QUANTITY_NAME[q])
-        if ok:
-            write.append(q)
-        if warning:
-            warnings.append(warning)
-    current = tool
-    before = after = None
-    for q in write:
-        b, a = tool_measure_update(current, q, measured[q], remeasure=ctx.bit(3), incremental=variant.incremental)
-        before = before or b
-        after = a
-        current = LatheTool.from_dict(a)
-    before = before or tool_dict(tool)
-    after = after or tool_dict(tool)
-    after["sl"], after["type"], after["t"], after["d"] = tool.sl, tool.type, tool.t, tool.d
+    write, warnings = _writable(call, variant, deltas)
+    before, after = _written(tool, write, measured, ctx, variant)
     ovr, ovi = tool_ovr(call, {QUANTITY_NAME[q]: (measured[q], deltas[q]) for q in measured}, ev_value, tool)
     ovi[9] = warnings[0].number if warnings else 0
     result_measured = {QUANTITY_NAME[q]: {"actual": measured[q], "difference": deltas[q]} for q in measured}

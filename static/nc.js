@@ -20,6 +20,17 @@
   document.addEventListener("input", function (event) {
     if (event.target.matches(".editor textarea")) number(event.target);
   });
+  // cycle support (program manager): where the cycle goes / which call is read = the cursor
+  function cursor(area) {
+    var form = area.closest("form");
+    var field = form ? form.querySelector("input[name=cursor]") : null;
+    if (field) field.value = String(area.selectionStart);
+  }
+  ["keyup", "click", "select", "input"].forEach(function (kind) {
+    document.addEventListener(kind, function (event) {
+      if (event.target.matches && event.target.matches(".editor textarea")) cursor(event.target);
+    });
+  });
   document.addEventListener("scroll", function (event) {
     var area = event.target;
     if (area.matches && area.matches(".editor textarea")) {

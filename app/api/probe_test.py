@@ -1,4 +1,5 @@
-"""The probe test (design.md §10.4, app/services/probe_test.py): start it, read it, cancel it."""
+"""The probe test and the repeatability check (design.md §10.4, app/services/probe_test.py,
+app/services/probe_health.py)."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ from fastapi import APIRouter, Body
 from pydantic import BaseModel, ConfigDict, Field, StrictFloat
 
 from app.access.deps import needs
-from app.deps import ProbeTestDep
+from app.deps import ProbeHealthDep, ProbeTestDep
 from app.services.probe_test import DEFAULT_TIMEOUT_S, MAX_TIMEOUT_S
 
 router = APIRouter(tags=["probes"])
@@ -40,3 +41,20 @@ def probe_test_state(probe_test: ProbeTestDep) -> dict:
 @router.delete("/probe/test", name="api_probe_test_cancel", dependencies=[needs("jog")])
 def cancel_probe_test(probe_test: ProbeTestDep) -> dict:
     return probe_test.cancel()
+
+
+@router.post("/probes/{n}/repeatability", name="api_probe_repeatability", dependencies=[needs("measure")])
+def probe_repeatability(n: int, health: ProbeHealthDep, body: Annotated[dict | None, Body()] = None) -> dict:
+    """Repeatability check (design.md §10.4, ISO 230-10 §7.1): from the current position the probe
+    finds the face ahead (``direction`` "X+" … "Z-", default "Z-"; or ``directions``, e.g. the four
+    of a ring gauge from its centre), then probes it ``touches`` times (default 10) from
+    ``clearance`` mm before it at the measuring feed. Answers ``{"n", "two_sigma", "range", "at",
+    "limit", "exceeded", "deviations", "calibration_id"}`` (mm); record ``n`` keeps it as
+    ``repeatability``. 409 when the probe is not ready or finds no face; nothing is stored then."""
+    return health.repeatability(n, body or {})
+
+
+@router.get("/probes/{n}/history", name="api_probe_history")
+def probe_history(n: int, health: ProbeHealthDep, probe: Literal["workpiece", "tool"] = "workpiece") -> list[dict]:
+    """The record's calibrations, repeatability checks and invalidations, newest first."""
+    return health.history(probe, n)

@@ -34,11 +34,11 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import brentq
 
 from .axis_lines import as_line, table_transform
 from .physics import SPINDLE_MOUNTS, rpy_matrix
 from .polygon import convex_pieces
+from .roots import brentq
 
 ROOT_XTOL = 1e-13          # mm, brentq tolerance on the path parameter
 _GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0

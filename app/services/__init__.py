@@ -18,6 +18,7 @@ from .nc import NcService, ProgramService
 from .offsets import OffsetService
 from .plant import PlantService
 from .plc import PlcSimulator
+from .probe_health import ProbeHealthService
 from .probe_test import ProbeTestService
 from .probes import ProbeService, ToolProbeService
 from .quality import QualityService
@@ -42,6 +43,7 @@ class Services:
     nc: NcService | None = None
     programs: ProgramService | None = None
     probe_test: ProbeTestService | None = None
+    probe_health: ProbeHealthService | None = None
     results: ResultsService | None = None
     quality: QualityService | None = None
     plant: PlantService | None = None

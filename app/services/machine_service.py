@@ -24,7 +24,9 @@ With a swivel head turned out of +Z the length goes along the machine's actual t
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import json
+import logging
 import threading
 import time
 from collections.abc import Callable, Mapping
@@ -54,7 +56,7 @@ from app.machine.protocol import (
 )
 from app.machine.scenario import Scenario
 from app.records import PROBE_TOOL_TYPE
-from db import Database
+from db import Database, StorageUnavailable
 from engine.alarms import all_alarms
 from engine.alarms import by_number as alarm_by_number
 from engine.coords import GEOMETRY_AXES, LatheToolTip, ToolTip, head_shift_of, length_axis
@@ -64,6 +66,8 @@ from engine.planes import plane as plane_by_name
 from . import lathe_data
 from .live import ChangeSignal
 from .settings import SettingsService
+
+log = logging.getLogger(__name__)
 
 CHANNEL = "CHAN1"
 MAX_TRAVEL = 10_000.0            # mm; a bigger single move is a typo
@@ -118,6 +122,10 @@ class MachineService:
         self._hold = HoldToRun(machine)
         self._frames: tuple[int, dict[str, Frame]] | None = None
         self._discard_listeners: list[Callable[[str], None]] = []
+        # probe health (design.md §10.4): alarms as they appear, scenario loads
+        self._alarm_listeners: list[Callable[[Alarm, dict], None]] = []
+        self._alarms_seen: frozenset[tuple[int, str, bool]] = frozenset()
+        self._scenario_listeners: list[Callable[[], None]] = []
         # one channel (issue 24 §3-4): what a Reset ends, what the mode group refuses, NC Stop's hold
         self._reset_listeners: list[tuple[Callable[[], None], Callable[[], None]]] = []
         self._interlocks: list[Callable[[str], None]] = []
@@ -130,15 +138,28 @@ class MachineService:
         with db.unit(readonly=True) as unit:
             active = unit.get_state(STATE_ACTIVE_OFFSET, G500)
             tool = unit.get_state(STATE_TOOL, None)
-        self._seed_data(reset=False)
-        self._take_nc_tools()
+        self._at_start(self._seed_data, False)
+        self._at_start(self._take_nc_tools)
         self._push_nc_data()
+        self._at_start(self._activate_stored, active)
+        self._at_start(self._restore_tool, tool)
+
+    def _activate_stored(self, active: str) -> None:
         try:
             self.activate(active if self._is_settable(active) else G500)
         except AlarmError:                     # a stored frame the NC cannot hold: no offset, alarm shown
             with contextlib.suppress(AlarmError):
                 self.activate(G500)
-        self._restore_tool(tool)
+
+    def _at_start(self, step: Callable[..., object], *args: object) -> None:
+        """A start-up step; on a database that cannot be written (design.md §10.8) what it would
+        store is left out and the HMI starts read only."""
+        try:
+            step(*args)
+        except StorageUnavailable as exc:
+            if not self._db.read_only:
+                raise
+            log.warning("start-up step left out (read-only database): %s", exc)
 
     # --- read-only views ----------------------------------------------------------------
     @property
@@ -209,6 +230,7 @@ class MachineService:
         of changed (the machine's status, mode, lock, offset, chain, plane, feed hold), so that
         polls and the live feed cost no frame arithmetic and no encoding at rest (issue 30)."""
         st = self._machine.status()
+        self._see_alarms(st)
         settings = self._settings.get()
         plane, units = settings.plane, settings.units
         mode = (self.mode_source() if self.mode_source else None) or st.mode
@@ -255,6 +277,41 @@ class MachineService:
             **self._probe_status(st),
             **(self._lathe_status(st) if self.is_lathe else {}),
         }
+
+    def on_alarm(self, listener: Callable[[Alarm, dict], None]) -> None:
+        """``listener(alarm, probes)`` once for each alarm that appears (``probes``: ``{"probe",
+        "tool_probe", "tool"}`` when it was seen). Seen on every status read and before a Reset or
+        a scenario load clears the alarms, so no alarm goes unseen (design.md §10.4)."""
+        self._alarm_listeners.append(listener)
+
+    def on_scenario(self, listener: Callable[[], None]) -> None:
+        """``listener()`` after a scenario load (another probe may be in the machine now)."""
+        self._scenario_listeners.append(listener)
+
+    def _see_alarms(self, st: MachineStatus | None = None) -> None:
+        if not self._alarm_listeners:
+            return
+        st = st or self._machine.status()
+        now = frozenset((a.code, a.text, a.resettable) for a in st.alarms)
+        with self._lock:
+            new = now - self._alarms_seen
+            self._alarms_seen = now
+        if not new:
+            return
+        probes = {**self._probe_status(st), "tool": st.tool}
+        for alarm in sorted(st.alarms, key=lambda a: a.resettable):      # the graver (a broken probe) first
+            if (alarm.code, alarm.text, alarm.resettable) in new:
+                for listener in self._alarm_listeners:
+                    listener(alarm, probes)
+
+    def probe_identity(self, which: str = "workpiece") -> str | None:
+        """A fingerprint of the scenario's probe (the tool probe: ``which="tool"``): what a real
+        control knows as the probe's serial number; None when there is no such probe."""
+        part = self._scenario.probe if which == "workpiece" else getattr(self._scenario, "tool_probe", None)
+        if part is None:
+            return None
+        text = json.dumps(part.model_dump(mode="json", exclude={"radio"}), sort_keys=True)
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
 
     def probe_status(self) -> dict:
         """``{"probe", "tool_probe"}`` of ``status()``, read alone (the probe test samples it)."""
@@ -531,6 +588,7 @@ class MachineService:
         runners are told to stop, the motion stops, the runners end (program reset to its
         defaults, measurement aborted), feed hold ends, the resettable alarms are cleared."""
         self._hold.release()
+        self._see_alarms()                      # a collision is seen before Reset clears it
         for stop, _wait in self._reset_listeners:
             stop()
         self._machine.reset()
@@ -728,6 +786,7 @@ class MachineService:
         self.interlock("scenario")
         self._ensure_idle()
         self._hold.release()
+        self._see_alarms()
         with self._lock:
             if getattr(scenario, "kind", "mill") != getattr(self._scenario, "kind", "mill"):
                 self._switch_machine(scenario)
@@ -742,6 +801,8 @@ class MachineService:
                 tool = unit.get_state(STATE_TOOL, None)
             self._restore_tool(tool)
         self._discard("A scenario was loaded")
+        for listener in self._scenario_listeners:
+            listener()
         return self.status()
 
     def _switch_machine(self, scenario: Scenario | LatheScenario) -> None:

@@ -246,13 +246,16 @@ class MeasuringEnv:
                 if outcome.after is not None:
                     tool_update = (outcome.tool, outcome.after)
             if probe_update is not None:
-                unit.put_probe(probe_update[0], probe_update[1], source=source, detail=detail)
+                record = self._calibrated(unit, "workpiece", probe_update[0], probe_update[1], entry)
+                unit.put_probe(probe_update[0], record, source=source, detail=detail)
             if tool_update is not None:
                 stored_tool = unit.put_tool(tool_update[0], tool_update[1], source=source, detail=detail)
             if tool_probe_update is not None:
-                unit.put_tool_probe(tool_probe_update[0], tool_probe_update[1], source=source, detail=detail)
+                record = self._calibrated(unit, "tool", tool_probe_update[0], tool_probe_update[1], entry)
+                unit.put_tool_probe(tool_probe_update[0], record, source=source, detail=detail)
             log_id = self.results.add_log(unit, entry) if self.results is not None else unit.add_log(entry)
             lines = self._kinematics_audit(unit, kinematics_update, log_id)
+        log_entry["calibration_id"] = entry.get("calibration_id")     # a calibration's new id, for the answer
         if lines is not None:                  # the NC holds what the audit says
             machine = self._ms.machine
             assert isinstance(machine, KinematicData), "kinematic_facts found the lines on this machine"
@@ -265,6 +268,17 @@ class MeasuringEnv:
             self._ms.write_tool(stored_tool["t"], stored_tool)
             self._ms.refresh_tool_offset()
         return log_id, outcome
+
+    def _calibrated(self, unit, probe: str, n: int, record: dict, entry: dict) -> dict:
+        """A calibration written: a new calibration id (its probe_events row), valid again, the
+        probe it was made with (design.md §10.4); the log entry carries the new id."""
+        data = {k: record.get(k) for k in ("calibrated_at", "calibrated_length", "calibrated_radius",
+                                           "calibrated_diameter", "trigger", "effective_diameter",
+                                           "measured_ball_diameter") if k in record}
+        event = unit.add_probe_event(probe, n, "calibration", {**data, "task": entry.get("task")})
+        entry["calibration_id"] = event["id"]
+        return {**record, "calibration_id": event["id"], "invalidated": None,
+                "probe_identity": self._ms.probe_identity(probe)}
 
     def _kinematics_audit(self, unit, update: dict | None, log_id: int) -> dict | None:
         """The audit row of a kinematics write (kind "kinematics", undoable); the lines to write."""

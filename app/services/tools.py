@@ -7,10 +7,12 @@ from pydantic import ValidationError
 
 from app import checks
 from app.errors import ConflictError, InvalidInput, NotFoundError
-from app.records import MAX_TOOL, ToolData
+from app.records import MAX_TOOL, ToolData, is_probe_tool
+from app.workflow import probe_trust
 from db import Database
 
 from .machine_service import MachineService
+from .probes import invalidation
 from .settings import raise_invalid
 
 TOOL_FIELDS = ("name", "type", "length", "radius", "wear.length", "wear.radius",
@@ -64,8 +66,10 @@ class ToolService:
         # read, merge and write in one writing unit: a concurrent change of another field (this or
         # another HMI process) is not overwritten by the value read before it (design.md §10.5)
         with self._db.unit() as unit:
+            before = unit.get_tool(int(t)) if isinstance(t, int) else None
             data = self.validate(t, changes, unit)
             stored = unit.put_tool(data["t"], data, source=source)
+            _probe_data_changed(unit, before, stored)
         self._stored(stored)
         return stored
 
@@ -121,3 +125,21 @@ class ToolService:
                 unit.delete_tool(t, source="api")
             except KeyError:
                 raise NotFoundError(f"T{t} is not in the tool table", code="unknown_tool") from None
+
+
+def _probe_data_changed(unit, before: dict | None, after: dict) -> None:
+    """The probe's ball (radius) or stylus length changed in the tool table: the calibrations of
+    the probe records bound to this tool are invalid (design.md §10.4)."""
+    if before is None or not is_probe_tool(after):
+        return
+    changed = [k for k in ("radius", "length") if before.get(k) != after.get(k)]
+    if not changed:
+        return
+    for record in unit.list_probes():
+        if record.get("tool") != after["t"] or not probe_trust.is_calibrated(record) or record.get("invalidated"):
+            continue
+        mark = invalidation("ball_changed", f"T{after['t']} {', '.join(changed)} changed in the tool table")
+        unit.add_probe_event("workpiece", record["number"], "invalidated", mark,
+                             calibration_id=record.get("calibration_id"))
+        unit.put_probe(record["number"], {**record, "invalidated": mark}, source="probe_health",
+                       detail={"reason": "ball_changed"})

@@ -60,31 +60,19 @@ def _bounds(scene: dict, limits: dict, path: list | None, focus) -> tuple[float,
 ALL = ("part", "groove", "tool_probe")
 
 
-def lathe_svg(scene: dict, limits: dict, *, path: list | None = None, svg_id: str = "view-lathe",
-              caption: str = "Lathe (X up, Z right, MCS radius)", focus=ALL) -> str:
-    """The SVG markup (a ``<figure>``); ``path`` = NC reference points [X, Y, Z] (MCS) to draw;
-    ``focus`` = what the view must hold besides the tool and the path."""
-    z0, z1, x0, x1 = _bounds(scene, limits, path, focus)
-    stroke = max((z1 - z0), (x1 - x0)) / 400.0
-    parts = [f'<figure class="view lathe-view"><figcaption>{escape(caption)}</figcaption>',
-             f'<svg id="{svg_id}" viewBox="{_f(z0)} {_f(-x1)} {_f(z1 - z0)} {_f(x1 - x0)}" '
-             f'preserveAspectRatio="xMidYMid meet" role="img" aria-label="lathe view" '
-             f'style="--stroke:{_f(stroke)}" data-kind="lathe">',
-             f'<rect class="table" x="{_f(z0)}" y="{_f(-x1)}" width="{_f(z1 - z0)}" height="{_f(x1 - x0)}"/>']
+def _solids(scene: dict, z0: float) -> list[str]:
+    """The chuck, the part (cylinders, then bores), the reference grooves and the tool probe."""
+    parts = []
     chuck = scene.get("chuck_face_z")
     part = scene.get("part") or []
     r_max = max([p["diameter"] / 2 + abs(p["axis_x"]) for p in part] or [20.0])
     if chuck is not None:
         parts.append(_rect(z0, chuck, -r_max - 25.0, r_max + 25.0, "chuck", ' data-kind="chuck"'))
-    for item in part:
-        if item["type"] != "cylinder":
-            continue
-        r, e = item["diameter"] / 2, item["axis_x"]
-        parts.append(_rect(item["z"][0], item["z"][1], e - r, e + r, "block", ' data-kind="part"'))
-    for item in part:
-        if item["type"] == "bore":
-            r, e = item["diameter"] / 2, item["axis_x"]
-            parts.append(_rect(item["z"][0], item["z"][1], e - r, e + r, "hole", ' data-kind="bore"'))
+    for kind, cls, data in (("cylinder", "block", "part"), ("bore", "hole", "bore")):
+        for item in part:
+            if item["type"] == kind:
+                r, e = item["diameter"] / 2, item["axis_x"]
+                parts.append(_rect(item["z"][0], item["z"][1], e - r, e + r, cls, f' data-kind="{data}"'))
     for groove in scene.get("grooves") or []:
         for r0, r1, gz0, gz1 in groove["rings"]:
             for sign in (1, -1):
@@ -93,12 +81,12 @@ def lathe_svg(scene: dict, limits: dict, *, path: list | None = None, svg_id: st
     tp = scene.get("tool_probe")
     if tp:
         parts.append(_rect(tp["Z+"], tp["Z-"], tp["X+"], tp["X-"], "tool_probe", ' data-kind="tool_probe"'))
-    parts.append(f'<line class="axis-line" x1="{_f(z0)}" y1="0" x2="{_f(z1)}" y2="0" '
-                 f'stroke-dasharray="{_f(stroke * 8)} {_f(stroke * 4)}"/>')
-    if path:
-        points = " ".join(f"{_f(p[2])},{_f(-p[0])}" for p in path)
-        parts.append(f'<polyline class="path" points="{points}" fill="none"/>')
-    probe = scene.get("probe") or {}
+    return parts
+
+
+def _tool(probe: dict, stroke: float) -> list[str]:
+    """The holder from F to the tip, F, the probe ball or the tool nose (and a tool's tip)."""
+    parts = []
     f = probe.get("f")
     tip = probe.get("tip")
     if f and tip:
@@ -115,5 +103,26 @@ def lathe_svg(scene: dict, limits: dict, *, path: list | None = None, svg_id: st
         if not probe.get("is_probe"):
             parts.append(f'<circle class="tip" cx="{_f(tip[2])}" cy="{_f(-tip[0])}" r="{_f(stroke * 2)}" '
                          'data-kind="tip"/>')
+    return parts
+
+
+def lathe_svg(scene: dict, limits: dict, *, path: list | None = None, svg_id: str = "view-lathe",
+              caption: str = "Lathe (X up, Z right, MCS radius)", focus=ALL) -> str:
+    """The SVG markup (a ``<figure>``); ``path`` = NC reference points [X, Y, Z] (MCS) to draw;
+    ``focus`` = what the view must hold besides the tool and the path."""
+    z0, z1, x0, x1 = _bounds(scene, limits, path, focus)
+    stroke = max((z1 - z0), (x1 - x0)) / 400.0
+    parts = [f'<figure class="view lathe-view"><figcaption>{escape(caption)}</figcaption>',
+             f'<svg id="{svg_id}" viewBox="{_f(z0)} {_f(-x1)} {_f(z1 - z0)} {_f(x1 - x0)}" '
+             f'preserveAspectRatio="xMidYMid meet" role="img" aria-label="lathe view" '
+             f'style="--stroke:{_f(stroke)}" data-kind="lathe">',
+             f'<rect class="table" x="{_f(z0)}" y="{_f(-x1)}" width="{_f(z1 - z0)}" height="{_f(x1 - x0)}"/>']
+    parts += _solids(scene, z0)
+    parts.append(f'<line class="axis-line" x1="{_f(z0)}" y1="0" x2="{_f(z1)}" y2="0" '
+                 f'stroke-dasharray="{_f(stroke * 8)} {_f(stroke * 4)}"/>')
+    if path:
+        points = " ".join(f"{_f(p[2])},{_f(-p[0])}" for p in path)
+        parts.append(f'<polyline class="path" points="{points}" fill="none"/>')
+    parts += _tool(scene.get("probe") or {}, stroke)
     parts.append("</svg></figure>")
     return "".join(parts)

@@ -75,7 +75,7 @@ def log_screen(request: Request, log: LogDep, page: Annotated[int, Query(ge=1, l
 # the first nine as before (extended, never renamed), then every other log field
 CSV_COLUMNS = ("id", "time", "task", "target", "status", "result", "correction", "result_json",
                "correction_json", "local_time", "measuring_wo", "warnings", "program", "block", "probe",
-               "params_json", "raw_json", "points_json", "probe_json", "part_id")
+               "params_json", "raw_json", "points_json", "probe_json", "part_id", "calibration_id")
 
 
 def _local_zone(tz: str | None):
@@ -113,7 +113,8 @@ def _csv_row(entry: dict, zone) -> list:
             entry.get("program") or "", entry.get("block") or "",
             f"probe {probe.get('number')}" if probe.get("number") is not None else "",
             as_json["params"], as_json["raw"], as_json["points"], as_json["probe"],
-            entry.get("part_id") if entry.get("part_id") is not None else ""]
+            entry.get("part_id") if entry.get("part_id") is not None else "",
+            entry.get("calibration_id") if entry.get("calibration_id") is not None else ""]
 
 
 @router.get("/log/export.csv", name="log_export_csv")

@@ -10,13 +10,14 @@ from fastapi import APIRouter, Form, Request
 from app.access.deps import needs
 from app.deps import MachineDep, MemoriesDep
 from app.errors import HmiError
+from app.i18n import N_
 from app.services.memories import WRITE_FUNCTION as MEMORY_WRITE
 
 from .templating import render_block, render_screen
 
 router = APIRouter()
 
-KIND_LABELS = {"ev": "Empirical value _EV", "mv": "Mean value _MV"}
+KIND_LABELS = {"ev": N_("Empirical value _EV"), "mv": N_("Mean value _MV")}     # translated where shown
 
 
 def memory_cell(kind: str, n: int, value, text=None, error=None) -> dict:

@@ -18,6 +18,8 @@ from app.access.deps import needs
 from app.api.nc import authorizer
 from app.deps import NcDep, ProgramsDep
 from app.errors import HmiError
+from app.i18n import _
+from app.nc import cycle_forms
 from app.services.nc import MDA, NcSyntaxInput
 
 from .templating import render_block, render_screen, url_path
@@ -133,8 +135,62 @@ def mda_single_block(request: Request, nc: NcDep, single_block: Annotated[str | 
 
 def _programs(request: Request, programs, nc, extra: dict | None = None, status_code: int = 200):
     return render_screen(request, "programs.html", {"screen": "programs", "programs": programs.list(),
-                                                    "selected": nc.status()["program"], **(extra or {})},
+                                                    "selected": nc.status()["program"], "cycle_names": list(cycle_forms.CYCLES),
+                                                    "cycle": None, "cycle_fields": None, "cycle_values": {}, "cursor": None,
+                                                    **(extra or {})},
                          status_code=status_code)
+
+
+def _line_bounds(text: str, cursor: int) -> tuple[int, int]:
+    """Start and end of the line the cursor stands in."""
+    cursor = max(0, min(cursor, len(text)))
+    start = text.rfind("\n", 0, cursor) + 1
+    end = text.find("\n", cursor)
+    return start, (len(text) if end < 0 else end)
+
+
+def _typed(field: cycle_forms.CycleField, typed: str) -> int | float:
+    value = float(typed.replace(",", "."))
+    return int(value) if field.kind == "int" and value == int(value) else value
+
+
+@router.post("/programs/{name}/cycle", name="programs_cycle", dependencies=[needs("measure")])
+async def programs_cycle(request: Request, name: str, programs: ProgramsDep, nc: NcDep):
+    """Cycle support (design.md §10.2, manual §7.2–7.3): ``action`` "form" shows the cycle's input
+    screen, "insert" writes the call with its parameters at the start of the cursor's line,
+    "read" fills the screen from the last call up to the cursor's line. Nothing is saved."""
+    form = await request.form()
+    text, action = str(form.get("text", "")), str(form.get("action", "form"))
+    cycle = str(form.get("cycle", "CYCLE977"))
+    try:
+        cursor = int(str(form.get("cursor", len(text))) or len(text))
+    except ValueError:
+        cursor = len(text)
+    start, end = _line_bounds(text, cursor)
+    editing = {"name": name, "text": text, "syntax": None}
+    values: dict = {}
+    error = None
+    try:
+        fields = cycle_forms.fields_of(cycle)
+        if action == "read":
+            cycle, values = cycle_forms.read(text[:end])
+            fields = cycle_forms.fields_of(cycle)
+        elif action == "insert":
+            typed = {k[2:]: str(v).strip() for k, v in form.items() if k.startswith("p:") and str(v).strip()}
+            try:
+                values = {k: _typed(fields[k], v) for k, v in typed.items() if k in fields}
+            except ValueError:
+                values = typed
+                raise cycle_forms.CycleFormError("params", _("Enter numbers in the cycle's fields")) from None
+            block = cycle_forms.render(cycle, values) + "\n"
+            editing["text"] = text[:start] + block + text[start:]
+            cursor = start + len(block)
+    except cycle_forms.CycleFormError as exc:
+        error = exc.message
+    return _programs(request, programs, nc, {"editing": editing, "cycle": cycle, "cursor": cursor,
+                                             "cycle_fields": [f.to_api(_) for f in cycle_forms.CYCLES[cycle]]
+                                             if cycle in cycle_forms.CYCLES else None,
+                                             "cycle_values": values, "cycle_error": error})
 
 
 @router.get("/programs", name="programs_screen")

@@ -13,6 +13,7 @@ from app.errors import HmiError
 from app.services.plc import MEANINGS
 from app.services.readiness import ReadinessService
 
+from . import plc_texts  # noqa: F401  (registers the PLC screen's texts)
 from .templating import render_block, render_screen
 
 router = APIRouter()

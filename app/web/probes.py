@@ -14,6 +14,7 @@ from fastapi import APIRouter, Request
 from app.access.deps import needs
 from app.deps import MachineDep, ProbesDep, SettingsDep
 from app.errors import HmiError
+from app.i18n import N_
 from app.services.lathe_data import GrooveService
 from app.services.measuring import probe_number_for
 
@@ -30,6 +31,52 @@ TRIGGERS = [("X-", 1, "travel −X (abscissa minus)"), ("X+", 2, "travel +X (abs
 # a lathe's _WP[k] (turning.md §0.7): trigger values per travel direction, radius values, G18
 LATHE_TRIGGERS = [("Z-", 1, "travel −Z (abscissa minus)"), ("Z+", 2, "travel +Z (abscissa plus)"),
                   ("X-", 3, "travel −X (ordinate minus)"), ("X+", 4, "travel +X (ordinate plus)")]
+
+
+# what made a calibration invalid (app.workflow.probe_trust.INVALID_REASONS), in the operator's words
+REASON_TEXTS = {
+    "not_calibrated": N_("not calibrated yet"),
+    "collision": N_("a collision after the calibration"),
+    "broken_probe": N_("the probe broke (overtravel) after the calibration"),
+    "ball_changed": N_("the ball or stylus data changed after the calibration"),
+    "other_probe": N_("another probe was loaded after the calibration"),
+    "age": N_("the calibration is older than its time limit"),
+}
+CHART_W, CHART_H, CHART_PAD = 360, 120, 30      # the repeatability chart, px of its viewBox
+HISTORY = 20                                     # checks shown in the chart
+
+
+def repeatability_chart(checks: list[dict], limit: float) -> dict | None:
+    """The last checks' 2σ (µm, oldest left) and the limit as an SVG chart (server-drawn, as the
+    run chart of the results screens); None without a check."""
+    values = [float(c["data"]["two_sigma"]) * 1000.0 for c in reversed(checks[:HISTORY])
+              if isinstance((c.get("data") or {}).get("two_sigma"), int | float)]
+    if not values:
+        return None
+    top = max(max(values), limit * 1000.0) * 1.2 or 1.0
+    left, right, bottom = CHART_PAD + 10, CHART_W - 10, CHART_H - CHART_PAD
+
+    def y(v: float) -> float:
+        return round(bottom - (bottom - 10) * v / top, 1)
+
+    step = (right - left) / max(len(values) - 1, 1)
+    dots = [{"x": round(left + i * step, 1), "y": y(v), "value": round(v, 2), "over": v > limit * 1000.0}
+            for i, v in enumerate(values)]
+    return {"width": CHART_W, "height": CHART_H, "left": left, "right": right, "bottom": bottom,
+            "limit_y": y(limit * 1000.0), "limit": round(limit * 1000.0, 2), "top": round(top, 2),
+            "dots": dots, "path": " ".join(f"{d['x']},{d['y']}" for d in dots)}
+
+
+def _health(request: Request, n: int, record: dict, settings) -> dict:
+    """The record's health for the screen: validity, its reason, the events, the chart."""
+    services = request.app.state.services
+    events = services.probe_health.history("workpiece", n) if services.probe_health is not None else []
+    checks = [e for e in events if e["event"] == "repeatability"]
+    gud = settings.get()
+    return {"health_record": record, "health_events": [e for e in events if e["event"] == "invalidated"][:10],
+            "health_checks": checks[:5], "reason_texts": REASON_TEXTS,
+            "chart": repeatability_chart(checks, float(gud.repeatability_limit)),
+            "max_age_h": float(gud.calibration_max_age_h)}
 
 
 def parse_form(form, stored: dict, lathe: bool = False) -> tuple[dict, dict[str, str]]:
@@ -117,7 +164,8 @@ def _screen(request: Request, probes, settings, machine, n: int | None = None, r
         "screen": "probes", "n": n, "active": active, "spindle": spindle,
         "records": records, "record": record, "triggers": LATHE_TRIGGERS if lathe else TRIGGERS,
         "errors": errors or {}, "texts": texts or {}, "message": message, "level": level,
-        "length_to_tip_gud": bool(settings.get().length_to_tip), **extra})
+        "length_to_tip_gud": bool(settings.get().length_to_tip), **extra,
+        **_health(request, n, probes.get(n) if any(r["number"] == n for r in records) else record, settings)})
 
 
 def _lathe_context(request: Request, record: dict) -> dict:

@@ -212,6 +212,25 @@ def _touch_height(entry: dict, frame: Frame, plane: Plane) -> float | None:
     return float(mean[AXES.index(plane.infeed)])
 
 
+def _feature_shapes(r: dict, points: list[dict], frame: Frame, at, along, normal: list[float]) -> list[dict]:
+    """The one feature of a result: a corner, a circle, a rectangle or the faces of a position."""
+    centre = r.get("center")
+    if isinstance(r.get("corner"), dict):
+        angle = float(r.get("angle", 0.0))
+        second = float(r["angle_2"]) if "angle_2" in r else angle + 90.0
+        return [{"kind": "corner", "at": at(r["corner"]), "dirs": [along(angle), along(second)]}]
+    if isinstance(centre, dict) and isinstance(r.get("diameter"), int | float):
+        return [{"kind": "circle", "at": at(centre), "normal": normal, "diameter": float(r["diameter"])}]
+    if isinstance(centre, dict) and isinstance(r.get("length"), int | float) and isinstance(r.get("width"), int | float):
+        return [{"kind": "rect", "at": at(centre), "normal": normal, "dirs": [along(0.0), along(90.0)],
+                 "size": [float(r["length"]), float(r["width"])]}]
+    if isinstance(r.get("position"), dict) and points:
+        return [{"kind": "face", "at": at(points[0]),
+                 "normal": _vec(frame.dir_child2parent(np.eye(3)[AXES.index(axis)]))}
+                for axis in r["position"] if axis in AXES]
+    return []
+
+
 def _shapes(r: dict, frame: Frame, plane: Plane, touch_height: float | None = None) -> list[dict]:
     """The result of one entry as 3D shapes (design.md §4 result keys, WCS of the measurement)."""
     points = [p for p in r.get("points") or [] if isinstance(p, dict)]
@@ -230,21 +249,7 @@ def _shapes(r: dict, frame: Frame, plane: Plane, touch_height: float | None = No
         return _vec(frame.dir_child2parent(c * plane.unit(plane.first) + s * plane.unit(plane.second)))
 
     shapes: list[dict] = [{"kind": "point", "at": at(p)} for p in points]
-    centre = r.get("center")
-    if isinstance(r.get("corner"), dict):
-        angle = float(r.get("angle", 0.0))
-        second = float(r["angle_2"]) if "angle_2" in r else angle + 90.0
-        shapes.append({"kind": "corner", "at": at(r["corner"]), "dirs": [along(angle), along(second)]})
-    elif isinstance(centre, dict) and isinstance(r.get("diameter"), int | float):
-        shapes.append({"kind": "circle", "at": at(centre), "normal": normal, "diameter": float(r["diameter"])})
-    elif isinstance(centre, dict) and isinstance(r.get("length"), int | float) and isinstance(r.get("width"), int | float):
-        shapes.append({"kind": "rect", "at": at(centre), "normal": normal, "dirs": [along(0.0), along(90.0)],
-                       "size": [float(r["length"]), float(r["width"])]})
-    elif isinstance(r.get("position"), dict) and points:
-        for axis in r["position"]:
-            if axis in AXES:
-                shapes.append({"kind": "face", "at": at(points[0]),
-                               "normal": _vec(frame.dir_child2parent(np.eye(3)[AXES.index(axis)]))})
+    shapes += _feature_shapes(r, points, frame, at, along, normal)
     if isinstance(r.get("p1"), dict) and isinstance(r.get("p2"), dict):
         shapes.append({"kind": "line", "from": at(r["p1"]), "to": at(r["p2"])})
     return shapes

@@ -49,7 +49,7 @@ HORIZONTAL_SOFTKEYS: list[tuple[str, str, str] | None] = [
 
 # on a lathe (turning.md §10.1) F1 opens the lathe's measuring menu, a product extension; F2 is empty
 LATHE_HORIZONTAL_SOFTKEYS: list[tuple[str, str, str] | None] = [
-    ("measure_lathe", "Measure lathe (ext.)", "measure_lathe_menu"), None, *HORIZONTAL_SOFTKEYS[2:]]
+    ("measure_lathe", N_("Measure turned part"), "measure_lathe_menu"), None, *HORIZONTAL_SOFTKEYS[2:]]
 
 
 def _route_index(app) -> dict:
@@ -151,6 +151,7 @@ templates.env.globals["result_value"] = texts.result_value
 templates.env.globals["source_text"] = texts.source_text
 templates.env.globals["log_status_text"] = texts.log_status_text
 templates.env.filters["label_text"] = texts.label_text
+templates.env.filters["breakable"] = texts.breakable          # soft hyphens in long key labels
 templates.env.globals["say"] = texts.translate_message      # a service's message in the operator's words
 templates.env.filters["say"] = texts.translate_message
 templates.env.globals["HORIZONTAL_SOFTKEYS"] = HORIZONTAL_SOFTKEYS

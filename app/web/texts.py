@@ -352,3 +352,17 @@ def result_value(key: str, value) -> str:
     if isinstance(value, int | float):
         return format_fixed(value, 4)
     return str(value)
+
+
+# --- soft hyphens in key labels (issue 29 item 3) -----------------------------------------------------
+# Chromium on Linux has no hyphenation dictionaries: a long German compound on a softkey breaks at
+# these joints (a soft hyphen shows "-" only where the line breaks), not at any letter.
+JOINTS = re.compile(r"(?<=\w{4})(?=(verschiebung|ansicht|liste|lungen|taster|speicher|kalibrier|messung|"
+                    r"vorschub|programm|protokoll|korrektur|daten|werte|einrichten|ausrichten|abstand)\b)",
+                    re.IGNORECASE)
+
+
+def breakable(label) -> str:
+    """``label`` with soft hyphens at the joints of its long words (12 letters or more)."""
+    text = str(label)
+    return re.sub(r"\w{12,}", lambda m: JOINTS.sub("\u00ad", m.group(0)), text)

@@ -103,6 +103,82 @@ def age_hours(calibrated_at: str | None, now: datetime | None = None) -> float |
     return max(0.0, ((now or datetime.now(UTC)) - when).total_seconds() / 3600.0)
 
 
+# what made a calibration invalid (design.md §10.4); the screens translate these texts
+INVALID_REASONS = {
+    "not_calibrated": "never calibrated",
+    "collision": "a collision after the calibration",
+    "broken_probe": "the probe broke (overtravel) after the calibration",
+    "ball_changed": "the ball or stylus data changed after the calibration",
+    "other_probe": "another probe was loaded (scenario) after the calibration",
+    "age": "older than the setting calibration_max_age_h",
+}
+HEALTH_KEYS = ("calibration_id", "probe_identity", "invalidated", "repeatability")   # kept by the HMI
+COMPUTED_KEYS = ("valid", "invalid_reason", "calibration_age_h")                      # worked out on read
+
+
+def is_calibrated(record: Mapping[str, Any] | None, probe: str = "workpiece") -> bool:
+    data = record or {}
+    if probe == "tool":
+        return bool(data.get("calibrated_length") or data.get("calibrated_diameter"))
+    return bool(data.get("calibrated_length") or data.get("calibrated_radius"))
+
+
+def validity(record: Mapping[str, Any] | None, max_age_h: float, probe: str = "workpiece",
+             now: datetime | None = None) -> tuple[bool, str | None]:
+    """(valid, reason) of ``record``'s calibration: never calibrated, invalidated by an event
+    (the first one), or older than ``max_age_h`` hours (0: no limit)."""
+    data = record or {}
+    if not is_calibrated(data, probe):
+        return False, "not_calibrated"
+    if data.get("invalidated"):
+        return False, str(data["invalidated"].get("reason") or "collision")
+    age = age_hours(data.get("calibrated_at"), now)
+    if max_age_h > 0 and age is not None and age > max_age_h:
+        return False, "age"
+    return True, None
+
+
+def with_validity(record: dict, max_age_h: float, probe: str = "workpiece") -> dict:
+    """``record`` with ``valid``, ``invalid_reason`` and ``calibration_age_h`` worked out now."""
+    valid, reason = validity(record, max_age_h, probe)
+    age = age_hours(record.get("calibrated_at"))
+    return {**record, "valid": valid, "invalid_reason": reason,
+            "calibration_age_h": None if age is None else round(age, 4)}
+
+
+def health_findings(record: Mapping[str, Any] | None, settings, probe: str = "workpiece") -> list[Finding]:
+    """An invalid calibration (an event or its age) and a repeatability above the limit (items 3, 4).
+    A record never calibrated is left to ``uncalibrated`` (it names the direction)."""
+    data = record or {}
+    out: list[Finding] = []
+    valid, reason = validity(data, float(settings.calibration_max_age_h), probe)
+    which = "tool probe" if probe == "tool" else "probe"
+    if not valid and reason != "not_calibrated":
+        out.append(Finding(alarms.CALIBRATION_INVALID, "calibration_invalid",
+                           f"{which} {data.get('number', '')}: {INVALID_REASONS.get(reason or '', reason)}; "
+                           "calibrate it again"))
+    last = data.get("repeatability") or {}
+    two_sigma = last.get("two_sigma")
+    if isinstance(two_sigma, int | float) and two_sigma > float(settings.repeatability_limit):
+        out.append(Finding(alarms.REPEATABILITY_EXCEEDED, "repeatability",
+                           f"{which} {data.get('number', '')}: 2σ {two_sigma * 1000:.1f} µm > limit "
+                           f"{float(settings.repeatability_limit) * 1000:.1f} µm"))
+    return out
+
+
+def calibration_of(category, ctx) -> dict:
+    """What a result says about the calibration it was measured with (design.md §10.4): the
+    tool probe's for tool measuring and its calibration, else the workpiece probe's."""
+    tool = category in (Category.TOOL_MEASURING, Category.TOOL_PROBE_CALIBRATION)
+    record = (ctx.extra.get("tool_probe") if tool else ctx.probe_data) or {}
+    valid, reason = validity(record, float(ctx.settings.calibration_max_age_h), "tool" if tool else "workpiece")
+    last = record.get("repeatability") or {}
+    return {"id": record.get("calibration_id"), "probe": "tool" if tool else "workpiece",
+            "number": record.get("number"), "at": record.get("calibrated_at"), "valid": valid,
+            "invalid_reason": reason, "repeatability": last.get("two_sigma"),
+            "repeatability_at": last.get("at")}
+
+
 def probing_directions(spec, params: dict, n: int, ctx, machine) -> list[np.ndarray]:
     """The travel directions (WCS) of point ``n``'s program from where the probe is now (the
     program the measurement will run, driven with ideal latches: nothing moves)."""
@@ -118,8 +194,16 @@ def probing_directions(spec, params: dict, n: int, ctx, machine) -> list[np.ndar
 
 
 def findings(spec, params: dict, n: int, ctx, machine) -> list[Finding]:
-    """Every reason not to trust the workpiece probe for point ``n`` of ``spec`` (module docstring)."""
-    if not spec.needs_probe or ctx.probe is None or spec.category == Category.TOOL_MEASURING:
+    """Every reason not to trust the probe for point ``n`` of ``spec`` (module docstring): the
+    workpiece probe for the workpiece tasks, the tool probe for tool measuring (item 6)."""
+    if spec.category == Category.TOOL_MEASURING:
+        return health_findings(ctx.extra.get("tool_probe"), ctx.settings, "tool")
+    if spec.category == Category.TOOL_PROBE_CALIBRATION:
+        return []
+    if not spec.needs_probe or ctx.probe is None:
         return []
     infeed, keys = needed_directions(ctx.plane, probing_directions(spec, params, n, ctx, machine))
-    return uncalibrated(ctx.probe_data, spec.name, infeed, keys, ctx.plane)
+    found = uncalibrated(ctx.probe_data, spec.name, infeed, keys, ctx.plane)
+    if spec.category != Category.PROBE_CALIBRATION:      # a calibration makes it valid again
+        found += health_findings(ctx.probe_data, ctx.settings)
+    return found

@@ -492,11 +492,22 @@ class WorkflowService:
                        "alarm": {**alarm, "point": progress.get("point"), "step": progress.get("label") or None}},
             "points": {f"P{s.n}": stored_point_to_api(s.point) for s in session.slots},
             "warnings": session.warnings,
+            "calibration_id": self._calibration_id(session),
         }
         try:
             self._env.commit_measurement(log_entry=entry)
         except StorageUnavailable:
             pass
+
+    def _calibration_id(self, session: MeasureSession) -> int | None:
+        """The calibration a failed attempt was made with (its log entry carries it too)."""
+        ctx = next((s.context for s in session.slots if s.context is not None), None)
+        if ctx is None:
+            try:
+                ctx = self._env.measuring_context()
+            except Exception:       # noqa: BLE001 - the alarm's log entry is written without it
+                return None
+        return probe_trust.calibration_of(self.spec(session.task).category, ctx)["id"]
 
     @staticmethod
     def _alarm_of(exc: Exception) -> dict:
@@ -642,6 +653,7 @@ class WorkflowService:
             "probe": ctx.probe_data,
             "warnings": session.warnings,
             "status": "ok",
+            "calibration_id": probe_trust.calibration_of(spec.category, ctx)["id"],
         }
         try:
             log_id, outcome = self._env.commit_measurement(log_entry=log_entry, **commit)
@@ -654,6 +666,12 @@ class WorkflowService:
             answer["correction"] = outcome.correction
             answer["_repeat"] = outcome.repeat
         answer["log_id"] = log_id
+        answer["calibration"] = {**probe_trust.calibration_of(spec.category, ctx),
+                                 "id": log_entry.get("calibration_id")}
+        written = commit.get("probe_update") or commit.get("tool_probe_update")
+        if written is not None:                 # this measurement was the calibration
+            answer["calibration"].update(valid=True, invalid_reason=None, at=written[1].get("calibrated_at"))
+        answer["calibration_id"] = log_entry.get("calibration_id")
         activate = answer.pop("_activate", None)
         if activate:
             self._env.activate(activate)

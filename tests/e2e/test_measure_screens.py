@@ -18,6 +18,9 @@ from live import browser_tab, wait_for_requests
 from playwright.sync_api import expect
 
 pytestmark = pytest.mark.e2e
+# a measurement's outcome on the screen: NC Start, the probing, the evaluation and the screen's answer
+# take a few seconds on a shared, loaded CI machine; the wait ends as soon as the outcome shows
+OUTCOME_MS = 20_000
 
 TOP_Z = -150.0                   # MCS of the block's top face
 POSE_T = np.array([200.0, 120.0, TOP_Z])
@@ -134,12 +137,12 @@ def fill(tab, **fields) -> None:
 
 def nc_start_point(tab, n: int) -> None:
     tab.locator("#nc-start").click()
-    expect(tab.locator(f'#vsoftkeys [data-point="{n}"]')).to_have_class(re.compile(r"\bstored\b"))
+    expect(tab.locator(f'#vsoftkeys [data-point="{n}"]')).to_have_class(re.compile(r"\bstored\b"), timeout=OUTCOME_MS)
 
 
 def nc_start_single(tab) -> None:
     tab.locator("#nc-start").click()
-    expect(tab.locator("#task-result")).to_be_visible()
+    expect(tab.locator("#task-result")).to_be_visible(timeout=OUTCOME_MS)
 
 
 def invalidate_and_repeat(tab, n: int) -> None:
@@ -153,7 +156,7 @@ def invalidate_and_repeat(tab, n: int) -> None:
 
 def calculate(tab) -> None:
     tab.locator("#vsoftkeys .calculate").click()
-    expect(tab.locator("#task-result")).to_be_visible()
+    expect(tab.locator("#task-result")).to_be_visible(timeout=OUTCOME_MS)
 
 
 def shown(tab, label: str) -> float:
@@ -230,7 +233,7 @@ def test_nc_start_right_after_a_new_target_shows_the_outcome(tab, station):
             route, answer = held[name]
             with tab.expect_response(url):
                 route.fulfill(response=answer)
-        expect(tab.locator("#task-result")).to_be_visible()
+        expect(tab.locator("#task-result")).to_be_visible(timeout=OUTCOME_MS)
         expect(tab.locator("#task-result .activation")).to_contain_text("activated")
         expect(tab.locator('#task-form select[name="target"]')).to_have_value("G54")
     finally:
