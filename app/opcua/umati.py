@@ -81,6 +81,7 @@ class MachineToolInstance:
         self._variables: dict[str, Node] = {}
         self._shown: dict[str, object] = {}
         self._mt = 0
+        self._state_numbers: dict[str, int] = {}
 
     def _id(self, path: str) -> ua.NodeId:
         return ua.NodeId(ua.String(f"umati.{INSTANCE}.{path}" if path else f"umati.{INSTANCE}"), ua.Int16(self._idx))
@@ -113,6 +114,15 @@ class MachineToolInstance:
             "ProgramStateId": await machine.get_child([f"{mt}:Production", f"{mt}:ActiveProgram", f"{mt}:State",
                                                        "0:CurrentState", "0:Id"]),
         }
+        current = self._variables["ProgramState"]
+        try:                                     # CurrentState/Number: the state's StateNumber (Part 5)
+            self._variables["ProgramStateNumber"] = await current.get_child("0:Number")
+            for name, state_id in PROGRAM_STATE.values():
+                state = self._server.get_node(numeric_id(state_id, mt))
+                self._state_numbers[name] = int(await (await state.get_child("0:StateNumber")).read_value())
+        except ua.UaError:
+            log.warning("umati: CurrentState/Number not shown (no Number or StateNumber in the node set)")
+            self._variables.pop("ProgramStateNumber", None)
         program = await machine.get_child([f"{mt}:Production", f"{mt}:ActiveProgram"])
         await (await program.get_child(f"{mt}:Name")).write_value("JOG measuring")
         await (await program.get_child("0:NumberInList")).write_value(ua.Variant(0, ua.VariantType.UInt16))
@@ -140,5 +150,7 @@ class MachineToolInstance:
             "ProgramState": ua.Variant(ua.LocalizedText(state_name), ua.VariantType.LocalizedText),
             "ProgramStateId": ua.Variant(numeric_id(state_id, self._mt), ua.VariantType.NodeId),
         }
+        if "ProgramStateNumber" in self._variables:
+            values["ProgramStateNumber"] = ua.Variant(self._state_numbers[state_name], ua.VariantType.UInt32)
         for name, variant in values.items():
             await set_if_changed(self._server, self._variables[name], variant, self._shown, name)

@@ -79,8 +79,13 @@ def test_the_channel_shows_mode_state_and_override_of_the_json_api(umati):
                       for n in ("ChannelMode", "ChannelState", "FeedOverride", "Name")]
             operation = await (await machine.get_child(
                 [f"{mt}:Monitoring", f"{mt}:MachineTool", f"{mt}:OperationMode"])).read_value()
-            state = await (await machine.get_child(
-                [f"{mt}:Production", f"{mt}:ActiveProgram", f"{mt}:State", "0:CurrentState"])).read_value()
+            current = await machine.get_child(
+                [f"{mt}:Production", f"{mt}:ActiveProgram", f"{mt}:State", "0:CurrentState"])
+            state = await current.read_value()
+            # issue 25: Number is the StateNumber the node set gives the state that Id names
+            state_node = client.get_node(await (await current.get_child("0:Id")).read_value())
+            expected = await (await state_node.get_child("0:StateNumber")).read_value()
+            assert await (await current.get_child("0:Number")).read_value() == expected
             return values, operation, state
 
     (mode, state, feed, name), operation, program = run(read())
