@@ -8,6 +8,7 @@ the access subcommands (design.md §9.2) work on the database:
     python -m app [--db PATH] token add NAME --level L     (prints the new token once)
     python -m app [--db PATH] token list | token delete NAME
     python -m app [--db PATH] keyswitch [POSITION]          (show or turn the simulated keyswitch)
+    python -m app [--db PATH] opcua trust add|list|remove CERT  (the OPC UA client certificates trusted)
 
 Without users the HMI is the stand-alone trainer and binds only to loopback: a ``--host`` other than
 loopback is refused until a user exists.
@@ -51,7 +52,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                         help="with --opcua: add the umati MachineTool instance (loaded in the background)")
     parser.add_argument("--mtconnect", type=int, default=None, metavar="PORT",
                         help="also serve an MTConnect SHDR adapter at HOST:PORT for an MTConnect agent")
-    commands = parser.add_subparsers(dest="command", metavar="{user,token,keyswitch}",
+    commands = parser.add_subparsers(dest="command", metavar="{user,token,keyswitch,opcua}",
                                      help="access administration (without one: serve the HMI)")
     user = commands.add_parser("user", help="users who sign in with a password (levels 1-3)")
     user_cmd = user.add_subparsers(dest="action", required=True)
@@ -74,7 +75,43 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     tdel.add_argument("name")
     key = commands.add_parser("keyswitch", help="show or turn the simulated keyswitch (0..3 = level 7..4)")
     key.add_argument("position", nargs="?", type=int, choices=(0, 1, 2, 3))
+    opcua = commands.add_parser("opcua", help="the OPC UA trust list of client certificates")
+    opcua_cmd = opcua.add_subparsers(dest="action", required=True)
+    trust = opcua_cmd.add_parser("trust", help="trust add CERT | trust list | trust remove THUMBPRINT|FILE")
+    trust.add_argument("trust_action", choices=("add", "list", "remove"))
+    trust.add_argument("cert", nargs="?", help="add: a certificate file (DER or PEM); remove: thumbprint or file")
     return parser.parse_args(argv)
+
+
+def run_trust_command(args: argparse.Namespace, settings: Settings) -> int:
+    """``opcua trust add|list|remove`` (design.md §10.8): the folder beside the database."""
+    from app.opcua.trust import TrustList
+
+    trust = TrustList(settings.db_path.parent)
+    if args.trust_action == "list":
+        for entry in trust.entries():
+            print(f"{entry['thumbprint']}  {entry['subject']}  ({entry['file']})")
+        rejected = sorted(p.name for p in trust.rejected.glob("*.der")) if trust.rejected.is_dir() else []
+        for name in rejected:
+            print(f"rejected: {trust.rejected / name}")
+        return 0
+    if not args.cert:
+        print(f"python -m app: opcua trust {args.trust_action} needs a certificate", file=sys.stderr)
+        return 2
+    if args.trust_action == "add":
+        try:
+            entry = trust.add(Path(args.cert))
+        except (OSError, ValueError) as exc:
+            print(f"python -m app: {args.cert} is no readable certificate ({exc})", file=sys.stderr)
+            return 1
+        print(f"trusted {entry['thumbprint']}  {entry['subject']}")
+        return 0
+    gone = trust.remove(args.cert)
+    if not gone:
+        print(f"python -m app: no trusted certificate {args.cert}", file=sys.stderr)
+        return 1
+    print("removed " + ", ".join(gone))
+    return 0
 
 
 def settings_from_args(args: argparse.Namespace) -> Settings:
@@ -206,6 +243,8 @@ def main(argv: list[str] | None = None) -> None:
     args = parse_args(argv)
     try:
         settings = settings_from_args(args)
+        if args.command == "opcua":
+            sys.exit(run_trust_command(args, settings))
         if args.command:
             sys.exit(run_access_command(args, settings))
         refusal = refuse_open_trainer(settings)

@@ -4,9 +4,8 @@ Aes256Sha256RsaPss (Sign, SignAndEncrypt), user tokens Anonymous and UserName.
 The server's certificate is self-signed, made at the first start into ``<data dir>/opcua/``
 (``server_key.pem``, readable by the owner only, and ``server_cert.der``, valid one year, renewed
 when it expires or the host name changes). With it a password is never sent in clear: on the None
-endpoint the UserName token is encrypted with the server's key (Basic256Sha256). Client
-certificates secure the channel only; they are not checked against a trust list, since who may
-write is decided by the user name. When the folder cannot be written the endpoint offers None with
+endpoint the UserName token is encrypted with the server's key (Basic256Sha256). A client
+certificate must be in the trust list (app/opcua/trust.py), else the session is refused. When the folder cannot be written the endpoint offers None with
 an unencrypted UserName token and says so in the log.
 """
 
@@ -25,6 +24,7 @@ from asyncua.crypto.cert_gen import (
 )
 from cryptography.x509.oid import ExtendedKeyUsageOID
 
+from .trust import TrustList
 from .users import HmiRuleset
 
 log = logging.getLogger(__name__)
@@ -45,6 +45,7 @@ async def configure(server: Server, data_dir: Path, app_uri: str) -> list[str]:
         await server.load_certificate(str(cert))
         await server.load_private_key(str(key))
         policies += SECURE
+        server.set_certificate_validator(TrustList(data_dir).validate)     # unknown client certificates: refused
     # asyncua annotates SimpleRoleRuleset but takes any PermissionRuleset (it calls check_validity only)
     server.set_security_policy(policies, permission_ruleset=HmiRuleset())  # type: ignore[arg-type]
     return [p.name for p in policies]

@@ -7,12 +7,15 @@ from __future__ import annotations
 import asyncio
 import json
 import time
+from pathlib import Path
 
 import pytest
 from asyncua import ua
 from hmi_testdata import PROBE_LENGTH, TEST_SCENARIO
 from opc_kit import USERS, node, opc_client, run, wait_for
 from waiting import wait_until
+
+from app.opcua.trust import TrustList
 
 
 def ok(response, status: int = 200):
@@ -188,6 +191,7 @@ def test_the_endpoints_offer_the_documented_policies_and_an_encrypted_session_wr
         client = Client(live.opc_url, timeout=10)
         client.application_uri = "urn:tests:opcua-client"
         cert, key = await client.setup_self_signed_certificate(tmp_path / "client_key.pem", tmp_path / "client_cert.der")
+        TrustList(live.app.state.services.db.path.parent).add(Path(cert))        # the administrator trusted it
         await client.set_security_string(f"Aes256Sha256RsaPss,SignAndEncrypt,{cert},{key}")
         client.set_user("serv")
         client.set_password(USERS["serv"][0])
@@ -248,3 +252,43 @@ def test_failed_opc_ua_sign_ins_hold_only_opc_ua_of_that_computer(live):
             return None
 
     assert wait_until(right_password_signs_in, "the OPC UA wait ends", 30) == "session"
+
+
+def test_an_untrusted_client_certificate_is_refused_and_kept_until_the_admin_trusts_it(live, tmp_path):
+    """Issue 25 item 5: unknown client certificates are rejected (Basic256Sha256 SignAndEncrypt);
+    the refused one waits in pki/rejected; ``python -m app opcua trust add`` lets it in."""
+    import subprocess
+    import sys
+
+    from asyncua import Client
+
+    data_dir = live.app.state.services.db.path.parent
+
+    async def connect(cert, key):
+        client = Client(live.opc_url, timeout=10)
+        client.application_uri = "urn:tests:untrusted-client"
+        await client.set_security_string(f"Basic256Sha256,SignAndEncrypt,{cert},{key}")
+        async with client:
+            return await (await node(client, await client.get_namespace_index("urn:jog-measure-hmi"),
+                                     "Machine", "ActiveOffset")).read_value()
+
+    async def make():
+        client = Client(live.opc_url, timeout=10)
+        client.application_uri = "urn:tests:untrusted-client"
+        return await client.setup_self_signed_certificate(tmp_path / "key.pem", tmp_path / "cert.der")
+
+    cert, key = run(make())
+    with pytest.raises(Exception) as refused:            # the channel or the session is refused
+        run(connect(cert, key))
+    assert "Untrusted" in repr(refused.value) or "BadCertificate" in repr(refused.value) \
+        or isinstance(refused.value, (ConnectionError, TimeoutError, asyncio.TimeoutError)), repr(refused.value)
+    rejected = TrustList(data_dir).rejected
+    kept = list(rejected.glob("*.der"))
+    assert len(kept) == 1
+    added = subprocess.run([sys.executable, "-m", "app", "--db", str(data_dir / "hmi.db"), "opcua", "trust", "add",
+                            str(kept[0])], capture_output=True, text=True, timeout=60)
+    assert added.returncode == 0 and added.stdout.startswith("trusted "), added.stderr
+    assert isinstance(run(connect(cert, key)), str)
+    listed = subprocess.run([sys.executable, "-m", "app", "--db", str(data_dir / "hmi.db"), "opcua", "trust",
+                             "list"], capture_output=True, text=True, timeout=60)
+    assert kept[0].stem in listed.stdout and not list(rejected.glob("*.der"))
