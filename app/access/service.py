@@ -270,6 +270,9 @@ class AccessService:
     def resolve(self, authorization: str | None, cookie_header: str | None) -> Identity:
         """Bearer token first, then the session cookie; without either: the trainer when no user
         exists, else nobody. Wrong credentials are INVALID (401), never the trainer."""
+        scheme, _, bearer = (authorization or "").partition(" ")
+        if scheme.lower() == "bearer" and not bearer.strip() and not self.signin_on():
+            authorization = None            # an empty "Bearer " of a trainer-mode client: no credentials
         if authorization:
             scheme, _, bearer = authorization.partition(" ")
             if scheme.lower() != "bearer" or not bearer.strip():
