@@ -44,7 +44,7 @@ DIRECTIONS = {f"{axis}{sign}": np.array([float(sign == "+") - float(sign == "-")
                                          for a in "XYZ"]) for axis in "XYZ" for sign in "+-"}
 MAX_TOUCHES = 100
 DEFAULT_TOUCHES = 10
-DEFAULT_DISTANCE = 10.0        # mm searched for the face
+DEFAULT_DISTANCE = 50.0        # mm searched for the face (a measuring move: it stops at the switch)
 DEFAULT_CLEARANCE = 1.0        # mm before the face where each counted touch starts
 BODY_KEYS = {"touches", "direction", "directions", "distance", "clearance", "feed"}
 COLLISIONS = (alarms.PROBE_COLLISION.number, alarms.COLLISION_LIMITED.number)
