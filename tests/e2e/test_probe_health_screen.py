@@ -10,6 +10,7 @@ from __future__ import annotations
 import pytest
 from hmi_testdata import TEST_SCENARIO, test_scenario
 from playwright.sync_api import expect
+from waiting import wait_until
 
 pytestmark = pytest.mark.e2e
 
@@ -68,6 +69,8 @@ def test_health_after_a_check_and_a_collision(page, api):
 def test_health_in_german(page, api):
     _calibrate_length(api)
     _ok(api.put("/api/settings", json={"calibration_max_age_h": 0.0001}))
+    # the record ages past 0.36 s on its own: open the screen once the API says it has
+    wait_until(lambda: _ok(api.get("/api/probes/1"))["invalid_reason"] == "age", "the calibration is too old", 10.0)
     assert api.get("/probes?n=1").status_code == 200
     page.goto("/probes?n=1&lang=de")
     health = page.locator("#probe-health")
