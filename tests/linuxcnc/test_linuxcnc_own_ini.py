@@ -93,18 +93,17 @@ def _serve(tmp_path: Path, ini: Path) -> tuple[subprocess.Popen, str]:
 
 
 def _wait_up(app: subprocess.Popen, url: str) -> dict:
-    deadline = time.monotonic() + 120.0
+    """The HMI's first ``GET /api/machine`` answer, once it serves (LinuxCNC started and homed)."""
     with httpx.Client(base_url=url, timeout=5) as http:
-        while True:
+        def answer() -> dict | None:
             assert app.poll() is None, "the HMI ended"
             try:
-                answer = http.get("/api/machine")
-                if answer.status_code == 200:
-                    return answer.json()
+                response = http.get("/api/machine")
             except httpx.TransportError:
-                pass
-            assert time.monotonic() < deadline, "the HMI did not come up"
-            time.sleep(0.2)
+                return None
+            return response.json() if response.status_code == 200 else None
+
+        return wait_until(answer, "the HMI comes up with LinuxCNC", 120.0)
 
 
 def test_sigkill_of_the_hmi_then_a_start_reaches_linuxcnc_and_sigterm_ends_a_measurement(tmp_path):
