@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import getpass
+import logging
 import sys
 import threading
 from pathlib import Path
@@ -25,6 +26,8 @@ from pathlib import Path
 from app.config import Settings
 from app.machine import registry
 from db import StorageUnavailable
+
+log = logging.getLogger(__name__)
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
@@ -294,8 +297,8 @@ def _stopping_server_class():
         def _reset(self) -> None:
             try:
                 self._stop_motion()
-            except Exception:   # noqa: BLE001 - the machine may refuse; the HMI stops anyway
-                pass
+            except Exception:   # noqa: BLE001 - the HMI stops anyway; why the Reset failed is logged
+                log.exception("Reset before stopping the HMI")
 
     return _StoppingServer
 

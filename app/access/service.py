@@ -23,7 +23,7 @@ from http.cookies import CookieError, SimpleCookie
 from pwdlib import PasswordHash
 from pwdlib.hashers.argon2 import Argon2Hasher
 
-from db import Database
+from db import Database, StorageUnavailable
 
 from .identity import ANONYMOUS, INVALID, NOBODY, PANEL, TOKEN, TRAINER, USER, Identity
 from .levels import KEYSWITCH_POSITIONS, PASSWORD_LEVELS, TOKEN_LEVELS, TRAINER_LEVEL, keyswitch_level
@@ -231,7 +231,7 @@ class AccessService:
         try:
             with self._db.unit() as unit:
                 unit.set_password_hash(name, new_hash)
-        except Exception as exc:       # noqa: BLE001 - a sign-in must not fail over this
+        except StorageUnavailable as exc:       # a read-only database: the sign-in goes on
             log.warning("password hash of %r not renewed: %s", name, exc)
 
     def user_identity(self, name: str) -> Identity | None:

@@ -8,6 +8,7 @@ transaction) -> activation. The service holds at most one session per machine.
 from __future__ import annotations
 
 import contextvars
+import logging
 import math
 import threading
 from collections.abc import Mapping
@@ -40,6 +41,8 @@ from engine.tasks import evaluate
 from engine.types import MeasuringError, averaged, translated
 
 __all__ = ["MEASURE_ONLY", "MeasuringContext", "WorkflowEnv", "WorkflowError", "WorkflowService"]
+
+log = logging.getLogger(__name__)
 
 
 class WorkflowService:
@@ -506,6 +509,7 @@ class WorkflowService:
             try:
                 ctx = self._env.measuring_context()
             except Exception:       # noqa: BLE001 - the alarm's log entry is written without it
+                log.exception("the calibration of a failed measurement")
                 return None
         return probe_trust.calibration_of(self.spec(session.task).category, ctx)["id"]
 
