@@ -283,6 +283,8 @@ class Segment:
 class GuardReport:
     segments: tuple[Segment, ...]
     complete: bool           # the program ran to its end (False: refused, or it stopped itself)
+    # the probing directions the program asked for, in its order (plan coordinates)
+    probe_directions: tuple[FloatArray, ...] = ()
 
     @property
     def refusal(self) -> Segment | None:
@@ -315,6 +317,7 @@ def check_program(program: Generator[Step, Latch | None, object], start: npt.Arr
     r = placement.ball_radius
     reply: Latch | None = None
     complete = False
+    directions: list[FloatArray] = []
     try:
         while True:
             step = program.send(reply)
@@ -328,6 +331,7 @@ def check_program(program: Generator[Step, Latch | None, object], start: npt.Arr
                 pos = target
             elif isinstance(step, ProbeStep):
                 d = np.asarray(step.direction, dtype=float)
+                directions.append(d)
                 end = pos + float(step.distance) * d
                 if not model.known:
                     hit_s: float | None = step.expected if step.expected is not None else step.distance / 2.0
@@ -352,7 +356,7 @@ def check_program(program: Generator[Step, Latch | None, object], start: npt.Arr
         complete = True
     except MeasuringError:
         pass                 # the program stops itself (no switch: 61301) before any harm
-    return GuardReport(tuple(segments), complete)
+    return GuardReport(tuple(segments), complete, tuple(directions))
 
 
 def _move_segment(index: int, label: str, a: FloatArray, b: FloatArray, model: ProtectionModel,

@@ -98,6 +98,10 @@ class SimulatedControl:
     def controller(self) -> str:
         return "sim"
 
+    def shown_alarms(self) -> tuple[Alarm, ...]:
+        """``status().alarms`` without the rest of the status (the step executor counts them)."""
+        return self._alarms.shown()
+
     def machine_part(self, scatter_sigma: float = 0.0) -> int:
         """The next part of the series replaces the workpiece (app.machine.series, turning.md §11);
         the machine keeps its position, tool, frame and alarms. Returns the part's number (1, 2, ...)."""

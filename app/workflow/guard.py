@@ -61,8 +61,11 @@ def check_point(machine, spec, params: dict, n: int, ctx) -> tuple[GuardReport, 
 
 def _unknown(steps) -> GuardReport:
     segments: list[Segment] = []
+    directions = []
     pos = None
     for step in steps:
+        if isinstance(step, ProbeStep):
+            directions.append(np.asarray(step.direction, dtype=float))
         if isinstance(step, MoveStep):
             target = np.asarray(step.target, dtype=float)
             segments.append(Segment(len(segments) + 1, step.label, "move", target if pos is None else pos,
@@ -73,7 +76,18 @@ def _unknown(steps) -> GuardReport:
             segments.append(Segment(len(segments) + 1, step.label, "probe", pos, end, "unknown"))
             travel = step.expected if step.expected is not None else step.distance / 2.0
             pos = pos + float(travel) * np.asarray(step.direction, dtype=float)
-    return GuardReport(tuple(segments), True)
+    return GuardReport(tuple(segments), True, tuple(directions))
+
+
+def ideal_directions(report: GuardReport) -> list[np.ndarray] | None:
+    """The probing directions of the point's program driven with ideal latches
+    (``probe_trust.probing_directions``), read from the guard's run of the same program when that
+    run answered every probing move with a contact or its expected travel and ended: the
+    program took the same branches. None: the guard's run cannot tell (run it with ideal latches)."""
+    if not report.complete or any(s.kind == "probe" and s.verdict not in ("contact", "unknown")
+                                  for s in report.segments):
+        return None
+    return list(report.probe_directions)
 
 
 def refusal_error(report: GuardReport, n: int, axes: tuple[str, ...], params: dict) -> GuardRefused | None:

@@ -193,16 +193,20 @@ def probing_directions(spec, params: dict, n: int, ctx, machine) -> list[np.ndar
     return [np.asarray(s.direction, dtype=float) for s in steps if isinstance(s, ProbeStep)]
 
 
-def findings(spec, params: dict, n: int, ctx, machine) -> list[Finding]:
+def findings(spec, params: dict, n: int, ctx, machine, directions: list[np.ndarray] | None = None
+             ) -> list[Finding]:
     """Every reason not to trust the probe for point ``n`` of ``spec`` (module docstring): the
-    workpiece probe for the workpiece tasks, the tool probe for tool measuring (item 6)."""
+    workpiece probe for the workpiece tasks, the tool probe for tool measuring (item 6).
+    ``directions``: ``probing_directions`` when known already (the start guard's run)."""
     if spec.category == Category.TOOL_MEASURING:
         return health_findings(ctx.extra.get("tool_probe"), ctx.settings, "tool")
     if spec.category == Category.TOOL_PROBE_CALIBRATION:
         return []
     if not spec.needs_probe or ctx.probe is None:
         return []
-    infeed, keys = needed_directions(ctx.plane, probing_directions(spec, params, n, ctx, machine))
+    if directions is None:
+        directions = probing_directions(spec, params, n, ctx, machine)
+    infeed, keys = needed_directions(ctx.plane, directions)
     found = uncalibrated(ctx.probe_data, spec.name, infeed, keys, ctx.plane)
     if spec.category != Category.PROBE_CALIBRATION:      # a calibration makes it valid again
         found += health_findings(ctx.probe_data, ctx.settings)

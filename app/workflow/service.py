@@ -339,12 +339,17 @@ class WorkflowService:
             warnings.append(tilted)
         if self._refuse_override(ctx):
             raise WorkflowError(409, "override_mismatch", warnings[-1])
-        distrust = probe_trust.findings(spec, session.params, n, ctx, self._env.machine)
+        # the start guard runs the point's program once; the probe-trust check reads its probing
+        # directions from that run (a second run with ideal latches only when it cannot tell)
+        guarded = session.guard and guard.guarded(spec)
+        report = self._guard_report(session, spec, n, ctx) if guarded else None
+        directions = guard.ideal_directions(report) if isinstance(report, guard.GuardReport) else None
+        distrust = probe_trust.findings(spec, session.params, n, ctx, self._env.machine, directions)
         if distrust and ctx.settings.calibration_invalid == "refuse":
             raise WorkflowError(409, distrust[0].code, distrust[0].message)
         warnings += [f.message for f in distrust]
-        if session.guard and guard.guarded(spec):
-            warnings += self._guard(session, spec, n, ctx)
+        if guarded:
+            warnings += self._guard_verdict(report, session, n)
         session.warnings = warnings
         session.running = True
         session.last_alarm = None
@@ -352,12 +357,24 @@ class WorkflowService:
         session.progress = {"point": n, "step": 0, "steps": None, "label": ""}
         return spec, n, ctx
 
-    def _guard(self, session: MeasureSession, spec: TaskSpec, n: int, ctx: MeasuringContext) -> list[str]:
+    def _guard_report(self, session: MeasureSession, spec: TaskSpec, n: int, ctx: MeasuringContext
+                      ) -> guard.GuardReport | Exception | None:
+        """The start guard's report of point ``n`` (None: the program raised its own alarm, which
+        NC Start raises; an other exception is raised where the guard's verdict is taken)."""
+        try:
+            return guard.check_point(self._env.machine, spec, session.params, n, ctx)[0]
+        except MeasuringError:
+            return None
+        except Exception as exc:     # noqa: BLE001 - raised in _guard_verdict, after the refusals before it
+            return exc
+
+    def _guard_verdict(self, report: guard.GuardReport | Exception | None, session: MeasureSession,
+                       n: int) -> list[str]:
         """The start guard (issue 24 §1): refuse before any motion (409 ``guard``); the warning
         when the control has no model to check against."""
-        try:
-            report, _coords = guard.check_point(self._env.machine, spec, session.params, n, ctx)
-        except MeasuringError:
+        if isinstance(report, Exception):
+            raise report
+        if report is None:
             return []                      # NC Start raises the program's own alarm
         refused = guard.refusal_error(report, n, ("X", "Y", "Z"), session.params)
         if refused is not None:
