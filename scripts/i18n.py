@@ -32,14 +32,15 @@ KEYWORDS = {"_": None, "N_": None, "gettext": None, "ngettext": (1, 2), "Text": 
 METHODS = [("app/locale/**", "ignore"), ("app/**.py", "python"), ("templates/**.html", "jinja2")]
 OPTIONS = {"templates/**.html": {"extensions": "jinja2.ext.i18n", "trimmed": "true"}}
 DATA_FILES = ("app/workflow/forms.py",)        # string constants of FieldSpec(...) calls
+FIELD_CALLS = ("FieldSpec", "_yes_no")         # (name, label, ...): the helpers that build a FieldSpec
 
 
 def _field_texts(path: Path):
-    """Label and choice texts of every ``FieldSpec(...)`` in ``path``: plain strings only (an
+    """Label and choice texts of every ``FieldSpec(...)`` (or ``_yes_no(...)``) in ``path``: plain strings only (an
     f-string label is translated by its pattern, app/web/texts.py ``label_text``)."""
     tree = ast.parse(path.read_text())
     for node in ast.walk(tree):
-        if not (isinstance(node, ast.Call) and getattr(node.func, "id", "") == "FieldSpec"):
+        if not (isinstance(node, ast.Call) and getattr(node.func, "id", "") in FIELD_CALLS):
             continue
         labels = list(node.args[1:2]) + [k.value for k in node.keywords if k.arg == "label"]
         for choices in [k.value for k in node.keywords if k.arg == "choices"]:

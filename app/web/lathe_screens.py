@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 from markupsafe import Markup
 
+from app.i18n import _
 from app.workflow.executor import StepExecutor
 from engine.turning_plan import lathe_planned_path, prepare
 from engine.types import MoveStep, ProbeStep
@@ -164,4 +165,4 @@ def lathe_svgs(env, spec, params: dict | None, answer: dict | None) -> list:
     focus = {"lathe.toolprobe.calibrate": ("tool_probe",), "lathe.tool.measure": ("tool_probe",),
              "lathe.tool.auto": ("tool_probe",), "lathe.probe.groove": ("groove",)}.get(spec.name, ("part",))
     return [Markup(lathe_svg(scene, limits, path=path, svg_id="task-lathe", focus=focus,
-                             caption="Real set-up, X up / Z right (MCS radius); dashed: the planned path"))]
+                             caption=_("Real set-up, X up / Z right (MCS radius); dashed: the planned path")))]

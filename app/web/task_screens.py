@@ -382,6 +382,8 @@ def _screen_context(env: _Env, page: TaskPage, form: dict | None, *, answer=None
                     "locked": f.locks and stored_any, "id": f.name.replace(".", "-")} for f in fields],
         "form_error": errors.get("_form"),
         "points": points, "n_points": n_points, "single": n_points == 1,
+        # on the tool probe the operator positions the tool, not the workpiece probe
+        "positions_tool": spec.category in (Category.TOOL_PROBE_CALIBRATION, Category.TOOL_MEASURING),
         "can_calculate": session is not None and session.can_calculate,
         "next_point": (session.next_point() if session is not None else 1) or None,
         "answer": answer, "setup": setup, "session_id": session.id if session is not None else None,

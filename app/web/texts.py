@@ -305,6 +305,11 @@ LABELS: list[tuple[re.Pattern, str]] = [
     (re.compile(r"Calibration height (?P<axis>\w+)\Z"), N_("Calibration height %(axis)s")),
     (re.compile(r"Rotary axis (?P<axis>\w+)\Z"), N_("Rotary axis %(axis)s")),
     (re.compile(r"Basic frame (?P<n>\w+)\Z"), N_("Basic frame %(n)s")),
+    # the lathe's values (app/workflow/forms.py lathe_form): radius or diameter, by the label's suffix
+    (re.compile(r"(?P<label>.+) \(radius\)\Z"), N_("%(label)s (radius)")),
+    (re.compile(r"(?P<label>.+) \(radius on X\)\Z"), N_("%(label)s (radius on X)")),
+    (re.compile(r"(?P<label>.+) \(Ø on X\)\Z"), N_("%(label)s (Ø on X)")),
+    (re.compile(r"(?P<label>.+) \(Ø\)\Z"), N_("%(label)s (Ø)")),
 ]
 FIELD_TEXTS = (   # labels and choices that are built in code (variables, not FieldSpec arguments)
     N_("Setpoint (nominal size)"), N_("Upper tolerance"), N_("Lower tolerance"), N_("Zero offset range"),
@@ -312,6 +317,8 @@ FIELD_TEXTS = (   # labels and choices that are built in code (variables, not Fi
     N_("Empirical / mean value memory"), N_("Direction"), N_("Direction P1"), N_("Direction P2"),
     N_("Axis"), N_("Coordinate rotation"), N_("Tool offset"), N_("Basic reference"), N_("none"),
     N_("P0"), N_("centre"),
+    # the lathe's labels before their radius / diameter suffix (app/workflow/forms.py lathe_form)
+    N_("Measuring path"), N_("Surface position"), N_("Setpoint"), N_("Diameter"), N_("Protection zone in X"),
 )
 
 

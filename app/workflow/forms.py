@@ -26,6 +26,7 @@ class FieldSpec:
     choices: tuple[tuple[str, str], ...] = ()   # (value, text)
     locks: bool = False             # decides how the points are probed: locked while one is stored
     group: str = ""                 # "tool": shown with the target "Tool offset" only
+    param: str = ""                 # the cycle's parameter name, shown under the label (lathe screens)
 
 
 @dataclass(frozen=True)
@@ -252,104 +253,113 @@ def number_text(value: float) -> str:
 # the setpoint, the 974/994 bands and their results are diameters, the rest radius values.
 
 LATHE_YES_NO = (("no", "No"), ("yes", "Yes"))
+RADIUS = " (radius)"           # label suffixes are translated by their pattern (app/web/texts.py LABELS)
 LATHE_TOOL_TARGET = "tool"
 
 
 def _x(env: FormEnv) -> str:
     """The label suffix of a value that follows diameter programming on X (turning.md §10.2 Units)."""
-    return " (Ø on X, DIAMON)" if env.diameter_programming else " (radius on X)"
+    return " (Ø on X)" if env.diameter_programming else " (radius on X)"
 
 
-def _yes_no(name: str, label: str, default: str = "no", locks: bool = False) -> FieldSpec:
-    return FieldSpec(name, label, "choice", default=default, choices=LATHE_YES_NO, locks=locks)
+def _yes_no(name: str, label: str, default: str = "no", locks: bool = False, param: str = "") -> FieldSpec:
+    return FieldSpec(name, label, "choice", default=default, choices=LATHE_YES_NO, locks=locks, param=param)
 
 
 def _lathe_axis(axes: tuple[str, ...], default: str = "X") -> FieldSpec:
-    labels = {"Z": "Z (_MA=1)", "X": "X (_MA=2)", "Y": "Y (_MA=3)"}
-    return FieldSpec("axis", "Measuring axis", "choice", default=default, choices=tuple((a, labels[a]) for a in axes))
+    return FieldSpec("axis", "Measuring axis", "choice", default=default, choices=tuple((a, a) for a in axes),
+                     param="_MA")
 
 
 def _lathe_common() -> list[FieldSpec]:
-    return [FieldSpec("measuring_path", "Measuring path _FA (radius)", unit="mm", default="2"),
-            FieldSpec("feed", "Measuring feed _VMS (0: 150/300)", unit="mm/min", default="0"),
-            FieldSpec("probe", "Probe number _PRNUM", default="1"),
-            FieldSpec("measurements", "Measurements at one place _NMSP", default="1")]
+    return [FieldSpec("measuring_path", "Measuring path" + RADIUS, unit="mm", default="2", param="_FA"),
+            FieldSpec("feed", "Measuring feed (0: 150 or 300)", unit="mm/min", default="0", param="_VMS"),
+            FieldSpec("probe", "Probe number", default="1", param="_PRNUM"),
+            FieldSpec("measurements", "Measurements at one place", default="1", param="_NMSP")]
+
+
+# the operator's words are the milling screens' (tool_offset_fields); the cycle's name under them
+LATHE_TOLERANCES = {"upper": ("Upper tolerance", "mm", "_TUL"), "lower": ("Lower tolerance", "mm", "_TLL"),
+                    "zero_range": ("Zero offset range", "mm", "_TZL"), "mean_range": ("Mean value range", "mm", "_TMV"),
+                    "dim_difference": ("Dimension difference", "mm", "_TDIF"), "safe_area": ("Safe area", "mm", "_TSA"),
+                    "k": ("Weighting factor k", "", "_K"), "evnum": ("Empirical / mean value memory", "", "_EVNUM")}
 
 
 def _lathe_tolerances(keys: tuple[str, ...], suffix: str) -> list[FieldSpec]:
-    labels = {"upper": ("Upper tolerance _TUL", "mm"), "lower": ("Lower tolerance _TLL", "mm"),
-              "zero_range": ("Zero offset range _TZL", "mm"), "mean_range": ("Mean value range _TMV", "mm"),
-              "dim_difference": ("Dimension difference _TDIF", "mm"), "safe_area": ("Safe area _TSA", "mm"),
-              "k": ("Weighting factor _K", ""), "evnum": ("EV/MV memory _EVNUM", "")}
-    out = [FieldSpec(f"tolerance.{k}", labels[k][0] + (suffix if labels[k][1] else ""), unit=labels[k][1])
-           for k in keys if k in labels]
+    out = [FieldSpec(f"tolerance.{k}", LATHE_TOLERANCES[k][0] + (suffix if LATHE_TOLERANCES[k][1] else ""),
+                     unit=LATHE_TOLERANCES[k][1], param=LATHE_TOLERANCES[k][2])
+           for k in keys if k in LATHE_TOLERANCES]
     if "keep_mean" in keys:
-        out.append(_yes_no("tolerance.keep_mean", "Keep the mean value over the parts _CHBIT[4]"))
+        out.append(_yes_no("tolerance.keep_mean", "Keep the mean value over the parts", param="_CHBIT[4]"))
     return out
 
 
 def _lathe_tool_target(correct: tuple[tuple[str, str], ...]) -> list[FieldSpec]:
-    return [FieldSpec("target.tool", "Tool T to correct", group="tool"),
-            FieldSpec("target.correct", "Correct", "choice", default="length", group="tool", choices=correct),
+    return [FieldSpec("target.tool", "Tool T to correct", group="tool", param="_TNUM"),
+            FieldSpec("target.correct", "Correct", "choice", default="length", group="tool", choices=correct,
+                      param="_KNUM"),
             FieldSpec("target.mode", "Correct into", "choice", default="wear", group="tool",
-                      choices=(("wear", "Wear"), ("geometry", "Geometry"))),
-            dataclasses.replace(_yes_no("target.inverse", "Inverse (_KNUM digit 5)"), group="tool")]
+                      choices=(("wear", "Wear"), ("geometry", "Geometry")), param="_CHBIT[6]"),
+            dataclasses.replace(_yes_no("target.inverse", "Inverse correction", param="_KNUM (digit 5)"),
+                                group="tool")]
 
 
 def lathe_form(variant: str, env: FormEnv) -> list[FieldSpec]:
     """The fields of the lathe task ``lathe.<variant>`` (turning.md §10.2; the manual's cycle
-    support screens measuring-math §10.1 with the cycle parameter in each label)."""
-    radius = " (radius)"
+    support screens measuring-math §10.1): each label in the operator's words, the cycle
+    parameter it sets in ``param`` (the screen shows it under the label)."""
+    radius = RADIUS
     axes = tuple(a for a in ("Z", "X", "Y") if a in env.plane.axes)
-    reference = FieldSpec("reference", "Probe data", "choice", default="machine",
-                          choices=(("machine", "machine-related _TP"), ("workpiece", "workpiece-related _TPW")))
-    compensation = FieldSpec("compensation", "Correction _CHBIT[3]", "choice", default="geometry",
+    reference = FieldSpec("reference", "Probe data", "choice", default="machine", param="_TP / _TPW",
+                          choices=(("machine", "machine-related"), ("workpiece", "workpiece-related")))
+    compensation = FieldSpec("compensation", "Tool data", "choice", default="geometry", param="_CHBIT[3]",
                              choices=(("geometry", "first measurement: geometry"), ("wear", "re-measurement: wear")))
-    direction = FieldSpec("direction", "Direction _MD (incremental)", "choice", default="-",
-                          choices=(("-", "−"), ("+", "+")))
+    direction = FieldSpec("direction", "Direction (incremental only)", "choice", default="-",
+                          choices=(("-", "−"), ("+", "+")), param="_MD")
+    incremental = _yes_no("incremental", "Incremental (tool placed by hand)", param="_MVAR")
     if variant == "toolprobe.calibrate":
-        return [_lathe_axis(("Z", "X")), reference, _yes_no("incremental", "Incremental (tool placed by hand)"),
+        return [_lathe_axis(("Z", "X")), reference, incremental,
                 direction, *_lathe_tolerances(("zero_range", "safe_area"), radius), *_lathe_common()]
     if variant in ("tool.measure", "tool.auto"):
         out = [] if variant == "tool.auto" else [_lathe_axis(("Z", "X"))]
         out += [reference, compensation]
         if variant == "tool.measure":
-            out += [_yes_no("incremental", "Incremental (tool placed by hand)"), direction]
+            out += [incremental, direction]
         return out + _lathe_tolerances(("zero_range", "dim_difference", "safe_area", "evnum"), radius) \
             + _lathe_common()
     if variant == "probe.groove":
-        return [FieldSpec("groove.number", "Reference groove _CALNUM", "choice", default="1",
+        return [FieldSpec("groove.number", "Reference groove", "choice", default="1", param="_CALNUM",
                           choices=(("1", "1"), ("2", "2"), ("3", "3"))),
                 _lathe_axis(("Z", "X")),
-                FieldSpec("direction", "Direction _MD", "choice", default="both",
+                FieldSpec("direction", "Direction", "choice", default="both", param="_MD",
                           choices=(("both", "both directions"), ("-", "−"), ("+", "+"))),
                 _yes_no("skew", "Position deviation (skew)"), _yes_no("ball_diameter", "Effective ball diameter"),
                 *_lathe_tolerances(("zero_range", "safe_area"), radius), *_lathe_common()]
     if variant == "probe.surface":
-        return [_lathe_axis(axes, "Z"), FieldSpec("direction", "Direction _MD", "choice", default="-",
+        return [_lathe_axis(axes, "Z"), FieldSpec("direction", "Direction", "choice", default="-", param="_MD",
                                                   choices=(("-", "−"), ("+", "+"))),
-                FieldSpec("setpoint", "Surface position _SETVAL" + _x(env), unit="mm"),
+                FieldSpec("setpoint", "Surface position" + _x(env), unit="mm", param="_SETVAL"),
                 *_lathe_tolerances(("zero_range", "safe_area"), radius), *_lathe_common()]
     keys = ("upper", "lower", "zero_range", "mean_range", "dim_difference", "safe_area", "k", "evnum", "keep_mean")
+    correct = (("length", "Length acting on the axis"), ("radius", "Radius"), ("l1", "L1"), ("l2", "L2"))
     if variant == "point":
         targets = ((MEASURE_ONLY, "Measure only"), *((n, n) for n in env.offsets if n.startswith("G")),
                    (LATHE_TOOL_TARGET, "Tool offset"))
-        return [FieldSpec("target", "Correction", "choice", default=MEASURE_ONLY, choices=targets),
+        return [FieldSpec("target", "Correction", "choice", default=MEASURE_ONLY, choices=targets, param="_KNUM"),
                 _lathe_axis(axes),
-                FieldSpec("setpoint", "Setpoint _SETVAL" + _x(env), unit="mm"),
-                _yes_no("reversal", "Spindle reversal 180° (_MVAR=1000)"),
-                FieldSpec("start_angle", "Start angle _STA1 (reversal)", unit="°", default="0"),
-                *_lathe_tool_target((("length", "Length acting on the axis"), ("radius", "Radius"),
-                                     ("l1", "L1"), ("l2", "L2"))),
+                FieldSpec("setpoint", "Setpoint" + _x(env), unit="mm", param="_SETVAL"),
+                _yes_no("reversal", "Spindle reversal 180°", param="_MVAR=1000"),
+                FieldSpec("start_angle", "Start angle of the reversal", unit="°", default="0", param="_STA1"),
+                *_lathe_tool_target(correct),
                 *_lathe_tolerances(keys, _x(env)), *_lathe_common()]
-    return [FieldSpec("target", "Correction", "choice", default=MEASURE_ONLY,
+    return [FieldSpec("target", "Correction", "choice", default=MEASURE_ONLY, param="_KNUM",
                       choices=((MEASURE_ONLY, "Measure only"), (LATHE_TOOL_TARGET, "Tool offset"))),
             _lathe_axis(axes),
-            FieldSpec("setpoint", "Diameter _SETVAL" + _x(env), unit="mm"),
+            FieldSpec("setpoint", "Diameter" + _x(env), unit="mm", param="_SETVAL"),
             _yes_no("inside", "Inside diameter (bore)"),
-            FieldSpec("zone.Z", "Protection zone _SZA (Z of the detour)", unit="mm"),
-            FieldSpec("zone.X", "Protection zone _SZO" + _x(env).replace(" on X", ""), unit="mm"),
-            _yes_no("use_ball_diameter", "Use the ball diameter _CHBIT[7]"),
-            *_lathe_tool_target((("length", "Length acting on the axis"), ("radius", "Radius"),
-                                 ("l1", "L1"), ("l2", "L2"))),
+            FieldSpec("zone.Z", "Protection zone in Z (detour)", unit="mm", param="_SZA"),
+            FieldSpec("zone.X", "Protection zone in X" + (" (Ø)" if env.diameter_programming else radius),
+                      unit="mm", param="_SZO"),
+            _yes_no("use_ball_diameter", "Use the ball diameter (probe not calibrated)", param="_CHBIT[7]"),
+            *_lathe_tool_target(correct),
             *_lathe_tolerances(keys, _x(env)), *_lathe_common()]

@@ -224,3 +224,52 @@ def test_tool_list_and_probe_data_show_l1_l2_sl(tab, lathe):
     tab.goto("/tool-probes")
     expect(tab.locator('[data-field="trigger.Z-"] input')).to_have_value("220.0000")
     expect(tab.locator("#screen")).to_contain_text("leading point")
+
+
+LATHE_SCREENS = (("Calibrate tool probe", "toolprobe"), ("Measure tool L1/L2", "tool"),
+                 ("Measure tool automatic", "toolauto"), ("Calibrate probe in groove", "groove"),
+                 ("Calibrate probe on surface", "surface"), ("1-point measurement", "point"),
+                 ("2-point measurement", "twopoint"))
+PARAMETER_NAME = re.compile(r"(^|[\s(])_[A-Z]{2,}")          # _TZL, _FA, _CHBIT[3], (_MVAR=1000)
+
+
+@pytest.mark.parametrize("lang", ["en", "de", "zh"])
+def test_lathe_screens_speak_the_operators_words(tab, lathe, lang):
+    """Issue 29 item 5: every label in the operator's words, the cycle parameter under it (a
+    secondary line), no spec reference; the feed's unit whole; the tool screens say that the
+    operator positions the tool."""
+    tab.goto(f"/jog?lang={lang}")
+    for label, slug in LATHE_SCREENS:
+        tab.goto(f"/measure/lathe/{slug}")
+        screen = tab.locator("#screen")
+        expect(screen).to_have_attribute("data-task", re.compile(r"^lathe\."))
+        assert "turning.md" not in screen.inner_text() and "§" not in screen.inner_text()
+        mains = screen.locator(".task-form .field > label .label-main").all_text_contents()
+        assert len(mains) >= 6, (slug, mains)
+        for text in mains:
+            assert not PARAMETER_NAME.search(text), (slug, text)
+            assert "DIAMON" not in text, (slug, text)
+        params = screen.locator(".task-form .field > label .cycle-param").all_text_contents()
+        assert {"_FA", "_VMS", "_PRNUM", "_NMSP"} <= set(params), (slug, params)
+        for option in screen.locator(".task-form select option").all_text_contents():
+            assert not PARAMETER_NAME.search(option), (slug, option)
+        path = screen.locator('[data-field="measuring_path"]')
+        expect(path.locator(".cycle-param")).to_have_text("_FA")
+        # the unit column shows "mm/min" on one line, nothing cut (it read "mm/m")
+        unit = screen.locator('[data-field="feed"] .unit')
+        expect(unit).to_have_text("mm/min")
+        fits = unit.evaluate("e => e.scrollWidth <= e.clientWidth + 1 && e.getBoundingClientRect().height < 20")
+        assert fits, slug
+        hint = screen.locator(".task-left > p.hint")
+        if slug in ("toolprobe", "tool", "toolauto"):
+            expect(hint).to_contain_text({"en": "Position the tool", "de": "Werkzeug", "zh": "刀具"}[lang])
+        else:
+            expect(hint).to_contain_text({"en": "Position the probe", "de": "Messtaster", "zh": "测量头"}[lang])
+    if lang == "en":
+        mains = tab.locator(".task-form .field > label .label-main").all_text_contents()
+        assert "Measuring feed (0: 150 or 300)" in mains and "Zero offset range (Ø on X)" in mains
+    else:
+        feed = tab.locator('[data-field="feed"] .label-main')
+        expect(feed).not_to_have_text(re.compile("Measuring feed"))
+        expect(tab.locator('[data-field="tolerance.zero_range"] .label-main')).not_to_have_text(
+            re.compile("Zero offset range"))
