@@ -226,10 +226,7 @@ def test_tool_list_and_probe_data_show_l1_l2_sl(tab, lathe):
     expect(tab.locator("#screen")).to_contain_text("leading point")
 
 
-LATHE_SCREENS = (("Calibrate tool probe", "toolprobe"), ("Measure tool L1/L2", "tool"),
-                 ("Measure tool automatic", "toolauto"), ("Calibrate probe in groove", "groove"),
-                 ("Calibrate probe on surface", "surface"), ("1-point measurement", "point"),
-                 ("2-point measurement", "twopoint"))
+LATHE_SCREENS = ("toolprobe", "tool", "toolauto", "groove", "surface", "point", "twopoint")
 PARAMETER_NAME = re.compile(r"(^|[\s(])_[A-Z]{2,}")          # _TZL, _FA, _CHBIT[3], (_MVAR=1000)
 
 
@@ -239,7 +236,7 @@ def test_lathe_screens_speak_the_operators_words(tab, lathe, lang):
     secondary line), no spec reference; the feed's unit whole; the tool screens say that the
     operator positions the tool."""
     tab.goto(f"/jog?lang={lang}")
-    for label, slug in LATHE_SCREENS:
+    for slug in LATHE_SCREENS:
         tab.goto(f"/measure/lathe/{slug}")
         screen = tab.locator("#screen")
         expect(screen).to_have_attribute("data-task", re.compile(r"^lathe\."))
