@@ -43,6 +43,7 @@ from engine.types import (
     StoredPoint,
     TaskResult,
     Touch,
+    probe_record,
 )
 
 _AXES = ("X", "Y", "Z")
@@ -128,7 +129,7 @@ def _touch_values(plane: Plane, touches: Sequence[Touch]) -> list[dict[str, floa
 def touch_radius(touch: Touch, probe: ProbeRecord | None, plane: Plane) -> float:
     """ρ of the touch's direction (measuring-math §5.3): the record's axis-parallel trigger value
     |t|, or with a lobing map (engine.lobing) the ρ(θ) make_touch applied, (s − c)·d̂."""
-    probe = probe or ProbeRecord()
+    probe = probe_record(probe, "the touch radius")
     if probe.lobing is None:
         return trigger_radius(probe, touch.direction, plane)
     return float((np.asarray(touch.surface, float) - np.asarray(touch.ball_centre, float)) @ touch.direction)

@@ -26,6 +26,7 @@ from engine.types import (
     ProbeStep,
     SpindleStep,
     Step,
+    probe_record,
 )
 
 if TYPE_CHECKING:
@@ -37,7 +38,7 @@ TWO_STAGE_RETRACT = 2.0   # mm back after the fast first touch (jog-measuring §
 @dataclass(frozen=True)
 class PlanContext:
     plane: Plane
-    probe: ProbeRecord
+    probe_record: ProbeRecord | None    # the workpiece probe (_WP); None: no probe in the spindle
     skew_wcs: FloatArray            # from compensation.skew_in_wcs
     spindle_angle: float = 0.0      # SPOS while probing (a probe's lobing map turns with it)
     wcs2bcs: Frame | None = None    # measuring WCS -> BCS (the lobing map's directions are machine ones)
@@ -70,6 +71,12 @@ class PlanContext:
     feed_factor1: float = 10.0      # E_MESS_F_FAK1
     feed_factor2: float = 0.0       # E_MESS_F_FAK2
     min_accuracy: float = 0.01      # E_MESS_MIN_D
+
+    @property
+    def probe(self) -> ProbeRecord:
+        """The workpiece probe record; NoProbeRecord when there is none (a tool task's context
+        has none: it measures a cutter)."""
+        return probe_record(self.probe_record, "planning a workpiece probing")
 
 
 class ParamError(ValueError):

@@ -34,7 +34,7 @@ from engine.plan_workpiece import (
     spigot_program,
 )
 from engine.planes import Plane
-from engine.types import EdgePoint, FloatArray, ProbeRecord, StoredPoint, TaskResult
+from engine.types import EdgePoint, FloatArray, ProbeRecord, StoredPoint, TaskResult, probe_record
 
 
 class Family(StrEnum):
@@ -176,4 +176,4 @@ def evaluate(task: str, params: dict[str, Any], points: Sequence[StoredPoint], p
     spec = ENGINE_TASKS.get(task)
     if spec is None or spec.evaluate is None:
         raise ValueError(f"unknown task {task!r}; known: {', '.join(WORKPIECE_TASKS)}")
-    return spec.evaluate(task, dict(params or {}), list(points), plane, probe or ProbeRecord())
+    return spec.evaluate(task, dict(params or {}), list(points), plane, probe_record(probe, f"evaluating {task}"))

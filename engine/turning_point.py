@@ -14,8 +14,6 @@ strategy's (engine.turning_workpiece.finish_workpiece); the ZO variant decides i
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 import numpy.typing as npt
 
@@ -41,11 +39,6 @@ from engine.turning_workpiece import (
     trigger_for,
 )
 from engine.types import MeasuringError
-
-
-def Cycle974(mvar: int, setval: float, **params: Any) -> WorkpieceCall:   # noqa: N802 (reads like the cycle call)
-    """The parameters of a CYCLE974 call (turning.md §5.4–turning §5.6): a WorkpieceCall with cycle 974."""
-    return WorkpieceCall(cycle=974, mvar=mvar, setval=setval, **params)
 
 
 def point_program(call: WorkpieceCall, start: npt.ArrayLike, ctx: LatheContext, label: str = "P1",

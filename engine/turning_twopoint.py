@@ -24,8 +24,6 @@ eccentricity in X cancels in s1 − s2 (both points at the same spindle angle).
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 import numpy.typing as npt
 
@@ -53,11 +51,6 @@ from engine.turning_workpiece import (
     trigger_for,
 )
 from engine.types import MeasuringError
-
-
-def Cycle994(mvar: int, setval: float, **params: Any) -> WorkpieceCall:   # noqa: N802 (reads like the cycle call)
-    """The parameters of a CYCLE994 call (turning.md §6.2): a WorkpieceCall with cycle 994."""
-    return WorkpieceCall(cycle=994, mvar=mvar, setval=setval, **params)
 
 
 def two_point_trigger(record: LatheProbe, k: str, ball_diameter: bool) -> float:

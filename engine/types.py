@@ -74,6 +74,22 @@ class ProbeRecord:
     lobing: LobingMap | None = field(default=None, compare=False)
 
 
+class NoProbeRecord(ValueError):
+    """A workpiece probe's geometry was needed but no probe record was given (no probe in the
+    spindle): the engine never assumes a ball (it once quietly took a 4 mm one)."""
+
+    def __init__(self, what: str):
+        super().__init__(f"{what}: no workpiece probe record (is a probe in the spindle?)")
+        self.what = what
+
+
+def probe_record(probe: ProbeRecord | None, what: str) -> ProbeRecord:
+    """``probe`` itself; :class:`NoProbeRecord` naming ``what`` needed it when it is None."""
+    if probe is None:
+        raise NoProbeRecord(what)
+    return probe
+
+
 # --- what one measuring point stores (P1..P4) ------------------------------------------
 
 @dataclass(frozen=True)

@@ -21,7 +21,7 @@ from app.records import is_probe_tool
 from engine import alarms
 from engine import plan as engine_plan
 from engine.compensation import skew_in_wcs
-from engine.types import MeasuringError, ProbeRecord
+from engine.types import MeasuringError
 
 
 def tool_probe_widths(settings: GudSettings, record: dict | None) -> tuple[float, float]:
@@ -106,7 +106,7 @@ def context_from(ctx, spec=None, params: dict | None = None) -> engine_plan.Plan
     manual's alarms; without a spec (live preview) they are filled in when a cutter is in the
     spindle."""
     s = ctx.settings
-    probe = ctx.probe or ProbeRecord()
+    probe = ctx.probe           # None without a probe in the spindle: a workpiece plan then refuses
     wcs2bcs = ctx.chain().wcs2bcs
     if spec is None:
         extra = tool_fields(ctx, check=False)
@@ -116,8 +116,8 @@ def context_from(ctx, spec=None, params: dict | None = None) -> engine_plan.Plan
         extra = {}
     return engine_plan.PlanContext(
         plane=ctx.plane,
-        probe=probe,
-        skew_wcs=skew_in_wcs(probe, wcs2bcs, ctx.spindle_angle) if ctx.probe else np.zeros(3),
+        probe_record=probe,
+        skew_wcs=skew_in_wcs(probe, wcs2bcs, ctx.spindle_angle) if probe is not None else np.zeros(3),
         spindle_angle=float(ctx.spindle_angle),
         wcs2bcs=wcs2bcs,
         measuring_feed=float(s.measuring_feed),

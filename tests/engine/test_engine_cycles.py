@@ -26,7 +26,7 @@ TRIG = {"X-": 2.990, "X+": -2.990, "Y-": 2.990, "Y+": -2.990, "Z-": 2.990}
 
 
 def ctx_for(probe: ProbeRecord, fa: float = 5.0) -> PlanContext:
-    return PlanContext(plane=G17, probe=probe, skew_wcs=np.zeros(3), measuring_path=fa)
+    return PlanContext(plane=G17, probe_record=probe, skew_wcs=np.zeros(3), measuring_path=fa)
 
 
 def drive(program, latch_of):

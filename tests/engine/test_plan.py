@@ -46,7 +46,7 @@ def calibrated_probe() -> ProbeRecord:
 def ctx_for(plane="G17", skew=SKEW, **kw) -> PlanContext:
     pl = PLANES[plane]
     skew_wcs = pl.to_xyz(np.array([skew[0], skew[1], 0.0]))   # skew in the plane
-    return PlanContext(plane=pl, probe=kw.pop("probe", calibrated_probe()), skew_wcs=skew_wcs, **kw)
+    return PlanContext(plane=pl, probe_record=kw.pop("probe", calibrated_probe()), skew_wcs=skew_wcs, **kw)
 
 
 def world_for(ctx: PlanContext, shapes, pre=PRE, **kw) -> World:
@@ -387,7 +387,7 @@ def tool_world(tool_r: float) -> World:
 
 def tool_ctx(**kw) -> PlanContext:
     tp = {"X-": 710.0, "X+": 690.0, "Y-": 410.0, "Y+": 390.0, "Z-": TP_TOP}
-    base = dict(plane=PLANES["G17"], probe=ProbeRecord(), skew_wcs=np.zeros(3), tool_probe=tp,
+    base = dict(plane=PLANES["G17"], probe_record=None, skew_wcs=np.zeros(3), tool_probe=tp,
                 mt_diameter_length=20.0, mt_diameter_radius=20.0)
     base.update(kw)
     return PlanContext(**base)

@@ -208,10 +208,11 @@ def test_point_tasks_end_to_end():
 def test_frames_refused():
     """turning.md §0.2: a scale factor -> 61310 in every cycle; a rotation in the plane -> 61330
     in CYCLE972/973/974/994 [L27895–L27899] (not listed for CYCLE982)."""
-    from engine.turning_point import Cycle974, point_program
+    from engine.turning_point import point_program
     from engine.turning_probe import Cycle973, probe_calibration_program
     from engine.turning_tools import Cycle982, toolprobe_program
-    from engine.turning_twopoint import Cycle994, two_point_program
+    from engine.turning_twopoint import two_point_program
+    from engine.turning_workpiece import WorkpieceCall
     t7 = LatheTool(t=7, d=1, type=500, sl=3, l1=10.0, l2=40.0, radius=5.0)
     probe = LatheTool(t=8, d=1, type=580, sl=7, radius=3.0)
     rec = LatheProbe(trigger={"X-": 3.0, "X+": -3.0, "Z-": 3.0})
@@ -219,8 +220,8 @@ def test_frames_refused():
         (lambda c: toolprobe_program(Cycle982(mvar=0, ma=2, cycle=972), xz(420, 240), c), t7, True),
         (lambda c: toolprobe_program(Cycle982(mvar=0, ma=2), xz(420, 240), c), t7, False),
         (lambda c: probe_calibration_program(Cycle973(mvar=0, ma=1, md=1, setval=0.0), xz(20, 30), c), probe, True),
-        (lambda c: point_program(Cycle974(mvar=0, setval=20.0), xz(20, 30), c), probe, True),
-        (lambda c: two_point_program(Cycle994(mvar=2, setval=20.0, szo=60, sza=50), xz(20, 30), c), probe, True),
+        (lambda c: point_program(WorkpieceCall(cycle=974, mvar=0, setval=20.0), xz(20, 30), c), probe, True),
+        (lambda c: two_point_program(WorkpieceCall(cycle=994, mvar=2, setval=20.0, szo=60, sza=50), xz(20, 30), c), probe, True),
     ]
     for make, tool, rotation in programs:
         for flags, alarm in (({"scale_active": True}, alarms.SCALE_FACTOR),

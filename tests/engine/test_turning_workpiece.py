@@ -19,10 +19,10 @@ from test_turning_probe import sl7_groove
 from engine import alarms
 from engine.turning import LatheContext, LatheProbe, LatheTool
 from engine.turning_offsets import ToolTarget
-from engine.turning_point import Cycle974, evaluate_point, point_program
+from engine.turning_point import evaluate_point, point_program
 from engine.turning_probe import Cycle973, evaluate_probe_calibration, probe_calibration_program
-from engine.turning_twopoint import Cycle994, evaluate_two_point, two_point_program
-from engine.turning_workpiece import finish_workpiece, symmetrise
+from engine.turning_twopoint import evaluate_two_point, two_point_program
+from engine.turning_workpiece import WorkpieceCall, finish_workpiece, symmetrise
 from engine.types import MeasuringError, MoveStep, ProbeStep, SpindleStep
 
 PROBE = LatheTool(t=9, d=1, type=580, sl=7, l1=40.123, l2=100.456, radius=3.0)
@@ -66,7 +66,7 @@ def test_5A_zero_offset():
     150 mm/min; the face at 60.150 switches at 63.145 -> s = 60.150, D = 0.150 -> G54 Z 200.150."""
     start = xz(18.0, 100.0)
     world = ProbeWorld(solids=[Solid(0.0, 30.0, 0.0, 60.15)], radius={"Z-": 2.995}, true_r=3.0, start=start)
-    call = Cycle974(mvar=100, setval=60.0, ma=1, tsa=1.0, knum=1, fa=1.0)
+    call = WorkpieceCall(cycle=974, mvar=100, setval=60.0, ma=1, tsa=1.0, knum=1, fa=1.0)
     m, ctx, world = run_974(call, start, world, wp(**{"Z-": 2.995}), diamon=True)
     (mv,) = moves(world)
     assert mv.target[2] == pytest.approx(63.995) and mv.coords == "WCS"
@@ -86,15 +86,15 @@ def test_zero_offset_on_x_halves_and_safe_area():
     """ZO on X with DIAMON: the frame moves by D/2 (radius); |D| > _TSA -> 61303; fine mode."""
     start = xz(40.0, 20.0)
     world = ProbeWorld(solids=[Solid(0.0, 30.02, 0.0, 50.0)], radius={"X-": 2.995}, true_r=3.0, start=start)
-    call = Cycle974(mvar=100, setval=60.0, ma=2, tsa=1.0, knum=1, fa=1.0)
+    call = WorkpieceCall(cycle=974, mvar=100, setval=60.0, ma=2, tsa=1.0, knum=1, fa=1.0)
     m, ctx, _ = run_974(call, start, world, wp(**{"X-": 2.995}), diamon=True, fine_offset=True)
     assert m.actual == pytest.approx(60.04, abs=1e-9)
     result = finish_workpiece(call, m, ctx, frame={"coarse": [1.0, 0.0, 0.0], "fine": [0.5, 0.0, 0.0]})
     assert result.frame_after["fine"][0] == pytest.approx(0.52, abs=1e-9) and result.frame_after["coarse"][0] == 1.0
     with pytest.raises(MeasuringError) as err:
-        finish_workpiece(Cycle974(mvar=100, setval=60.0, ma=2, tsa=0.03, knum=1, fa=1.0), m, ctx)
+        finish_workpiece(WorkpieceCall(cycle=974, mvar=100, setval=60.0, ma=2, tsa=0.03, knum=1, fa=1.0), m, ctx)
     assert err.value.definition is alarms.SAFE_AREA
-    only = finish_workpiece(Cycle974(mvar=100, setval=60.0, ma=2, tsa=1.0, knum=0, fa=1.0), m, ctx,
+    only = finish_workpiece(WorkpieceCall(cycle=974, mvar=100, setval=60.0, ma=2, tsa=1.0, knum=0, fa=1.0), m, ctx,
                             frame={"coarse": [1.0, 0.0, 0.0], "fine": [0.5, 0.0, 0.0]})
     assert only.values["decision"] == "none" and only.compensation == 0.0 and only.frame_after is None
 
@@ -117,7 +117,7 @@ def test_5B_parts(latched, actual, dev):
     """5-B table: latched ball centre -> act (dia) and D = act − 0.002 − 44.995; positioning
     26.495 (display X52.990), window to 24.495."""
     start = xz(45.0, 30.0)
-    call = Cycle974(mvar=0, setval=45.0, **CALL_5B)
+    call = WorkpieceCall(cycle=974, mvar=0, setval=45.0, **CALL_5B)
     m, _, world = run_974(call, start, od_world(latched - 2.995, start), wp(**{"X-": 2.995}), ev=0.002,
                           diamon=True, chbit={4: 1})
     (mv,) = moves(world)
@@ -133,7 +133,7 @@ def test_5B_corrections():
     """5-B: the strategy's amounts give c = −A/2 on L1 wear of T7 D1: part 1 Mv 0.0025 ->
     −0.00125; part 2 (62304) D 0.012 -> −0.006; part 3 (62305) −0.007 -> +0.0035; part 4 none."""
     start = xz(45.0, 30.0)
-    call = Cycle974(mvar=0, setval=45.0, **CALL_5B)
+    call = WorkpieceCall(cycle=974, mvar=0, setval=45.0, **CALL_5B)
     t7 = LatheTool(t=7, d=1, type=500, sl=3, l1=60.0, l2=30.0, radius=0.8, wear_l1=0.01)
     m, ctx, _ = run_974(call, start, od_world(22.5005, start), wp(**{"X-": 2.995}), ev=0.002, diamon=True,
                         chbit={4: 1})
@@ -163,7 +163,7 @@ def test_5B_inside_diameter():
     start = xz(0.0, 40.0)
     true_r = 0.5 * (35.0075 + 0.012 + 0.003)                 # ID so that D (after EV 0.003) = +0.012
     world = ProbeWorld(solids=[Solid(true_r, 40.0, -20.0, 60.0)], radius={"X+": 2.993}, true_r=3.0, start=start)
-    call = Cycle974(mvar=0, setval=35.0, **{**CALL_5B, "tul": 0.015, "tll": 0.0, "tnum": 8, "evnum": 14})
+    call = WorkpieceCall(cycle=974, mvar=0, setval=35.0, **{**CALL_5B, "tul": 0.015, "tll": 0.0, "tnum": 8, "evnum": 14})
     m, ctx, world = run_974(call, start, world, wp(**{"X+": -2.993}), ev=0.003, diamon=True, chbit={4: 1})
     assert world.steps[0].target[0] == pytest.approx(17.5 - 2.993 - 1.0)
     assert m.direction == 1 and m.deviation == pytest.approx(0.012, abs=1e-9)
@@ -182,7 +182,7 @@ def test_5C_reversal():
     act 45.006, D = 0.011 -> c = −0.0055; without reversal act 45.066, D 0.071, c −0.0355."""
     start = xz(45.0, 30.0)
     world = od_world(22.503, start, ecc=(0.03, 0.0))
-    call = Cycle974(mvar=1000, setval=45.0, **CALL_5C)
+    call = WorkpieceCall(cycle=974, mvar=1000, setval=45.0, **CALL_5C)
     m, ctx, world = run_974(call, start, world, wp(**{"X-": 2.995}), diamon=True)
     spos = [s.angle for s in world.steps if isinstance(s, SpindleStep)]
     assert spos == [0.0, 180.0]
@@ -194,7 +194,7 @@ def test_5C_reversal():
     assert isinstance(world.steps[0], SpindleStep)                 # SPOS _STA1 with the probe at its start
     result = finish_workpiece(call, m, ctx, decision="oversize", amount=m.deviation, warning=alarms.OVERSIZE)
     assert result.compensation == pytest.approx(-0.0055, abs=1e-9)
-    once = Cycle974(mvar=0, setval=45.0, **CALL_5C)
+    once = WorkpieceCall(cycle=974, mvar=0, setval=45.0, **CALL_5C)
     m0, ctx0, _ = run_974(once, start, od_world(22.503, start, ecc=(0.03, 0.0)), wp(**{"X-": 2.995}), diamon=True)
     assert m0.actual == pytest.approx(45.066, abs=1e-9) and m0.deviation == pytest.approx(0.071, abs=1e-9)
     assert m0.actual - m.actual == pytest.approx(2 * 0.03, abs=1e-9)           # twice e_X
@@ -206,7 +206,7 @@ def test_5C_reversal():
 def test_5C_eccentricity_in_y_residual():
     """e = 0.030 in Y: the reversal leaves −(R + r) + sqrt((R + r)² − e²) ≈ −1.8e-5 in s (§5.6, §11)."""
     start = xz(45.0, 30.0)
-    m, _, _ = run_974(Cycle974(mvar=1000, setval=45.0, **CALL_5C), start, od_world(22.503, start, ecc=(0.0, 0.03)),
+    m, _, _ = run_974(WorkpieceCall(cycle=974, mvar=1000, setval=45.0, **CALL_5C), start, od_world(22.503, start, ecc=(0.0, 0.03)),
                       wp(**{"X-": 2.995}), diamon=True)
     residual = math.sqrt((22.503 + 3.0) ** 2 - 0.03 ** 2) - (22.503 + 3.0)
     assert m.surface - 22.503 == pytest.approx(residual, abs=1e-9)
@@ -221,13 +221,13 @@ def test_reversal_truth(radius, ex, angle, eff, diamon, nmsp):
     off by the eccentricity's X component at that angle (twice in the diameter)."""
     start = xz(radius + 6.0, 30.0)
     setval = 2 * radius if diamon else radius
-    call = Cycle974(mvar=1000, setval=setval, ma=2, sta1=angle, fa=2.0, tsa=5.0, tdif=5.0, nmsp=nmsp)
+    call = WorkpieceCall(cycle=974, mvar=1000, setval=setval, ma=2, sta1=angle, fa=2.0, tsa=5.0, tdif=5.0, nmsp=nmsp)
     m, _, _ = run_974(call, start, od_world(radius, start, eff=eff, ecc=(ex, 0.0)), wp(**{"X-": eff}), diamon=diamon)
     a = math.radians(angle)
     rho = radius + 3.0                     # the ball centre's circle about the clamped axis (§5.6, §11)
     residual = math.sqrt(rho ** 2 - (ex * math.sin(a)) ** 2) - rho          # second order in e_Y(φ)
     assert m.surface == pytest.approx(radius + residual, abs=1e-9)
-    single = Cycle974(mvar=0, setval=setval, ma=2, fa=2.0, tsa=5.0, tdif=5.0)
+    single = WorkpieceCall(cycle=974, mvar=0, setval=setval, ma=2, fa=2.0, tsa=5.0, tdif=5.0)
     world = od_world(radius, start, eff=eff, ecc=(ex, 0.0))
     world.angle = angle
     m1, _, _ = run_974(single, start, world, wp(**{"X-": eff}), diamon=diamon)
@@ -250,7 +250,7 @@ def test_6A_outside_with_protection_zone():
     """6-A: P1 26.495 -> 24.495, switch 25.5145 -> s1 22.5195; detour X27.5, Z55, X−27.5, Z30;
     P2 −26.493 -> −24.493, switch −25.4725 -> s2 −22.4795; D_act 44.999, D 0.003; ends −26.493."""
     start = xz(30.0, 30.0)
-    call = Cycle994(mvar=2, setval=45.0, **CALL_6A)
+    call = WorkpieceCall(cycle=994, mvar=2, setval=45.0, **CALL_6A)
     m, ctx, world = run_994(call, start, world_6a(start=start), WP_6A, ev=0.001, diamon=True, chbit={4: 1})
     targets = [(round(s.target[0], 9), round(s.target[2], 9)) for s in moves(world)]
     assert targets == [(26.495, 30.0), (27.5, 30.0), (27.5, 55.0), (-27.5, 55.0), (-27.5, 30.0), (-26.493, 30.0)]
@@ -271,7 +271,7 @@ def test_6A_outside_with_protection_zone():
 def test_6A_next_part():
     """6-A next part, D_act 45.0005 -> D 0.0045 (the strategy's Mv 0.0025667 is then > _TZL)."""
     start = xz(30.0, 30.0)
-    m, _, _ = run_994(Cycle994(mvar=2, setval=45.0, **CALL_6A), start, world_6a(radius=22.50025, start=start),
+    m, _, _ = run_994(WorkpieceCall(cycle=994, mvar=2, setval=45.0, **CALL_6A), start, world_6a(radius=22.50025, start=start),
                       WP_6A, ev=0.001, diamon=True)
     assert m.actual == pytest.approx(45.0005, abs=1e-9) and m.deviation == pytest.approx(0.0045, abs=1e-9)
 
@@ -279,7 +279,7 @@ def test_6A_next_part():
 def test_6B_ball_diameter():
     """6-B: _CHBIT[7]=1 with _WP[0,0] = 6.000: D_act = (25.5145 + 25.4725) − 6 = 44.987."""
     start = xz(30.0, 30.0)
-    m, _, _ = run_994(Cycle994(mvar=2, setval=45.0, **CALL_6A), start, world_6a(start=start), WP_6A, ev=0.001,
+    m, _, _ = run_994(WorkpieceCall(cycle=994, mvar=2, setval=45.0, **CALL_6A), start, world_6a(start=start), WP_6A, ev=0.001,
                       diamon=True, chbit={7: 1})
     assert m.actual == pytest.approx(44.987, abs=1e-9)
 
@@ -291,7 +291,7 @@ def test_6A_inside_and_variants():
     solids = [Solid(bore, 40.0, -40.0, 50.0)]
     start = xz(10.0, 30.0)
     world = ProbeWorld(solids=solids, radius={"X-": 2.995, "X+": 2.993}, true_r=3.0, start=start)
-    call = Cycle994(mvar=2, setval=35.0, **{**CALL_6A, "tul": 0.015, "tnum": 9, "evnum": 4})
+    call = WorkpieceCall(cycle=994, mvar=2, setval=35.0, **{**CALL_6A, "tul": 0.015, "tnum": 9, "evnum": 4})
     m, ctx, world = run_994(call, start, world, WP_6A, diamon=True)
     assert m.inside and m.actual == pytest.approx(35.008, abs=1e-9)
     assert [s.direction[0] for s in world.steps if isinstance(s, ProbeStep)] == [1.0, -1.0]
@@ -302,15 +302,15 @@ def test_6A_inside_and_variants():
     result = finish_workpiece(call, m, ctx, decision="full", amount=0.002, target=r_target)
     assert result.compensation == pytest.approx(0.001) and result.quantity == "radius"     # ID radius: +Δ
     world = ProbeWorld(solids=solids, radius={"X-": 2.995, "X+": 2.993}, true_r=3.0, start=start)
-    m1, _, world = run_994(Cycle994(mvar=1, setval=35.0, **CALL_6A), start, world, WP_6A, diamon=True)
+    m1, _, world = run_994(WorkpieceCall(cycle=994, mvar=1, setval=35.0, **CALL_6A), start, world, WP_6A, diamon=True)
     assert m1.actual == pytest.approx(35.008, abs=1e-9)
     assert max(s.target[2] for s in moves(world)) == 55.0
     with pytest.raises(MeasuringError) as err:
-        run_994(Cycle994(mvar=1, setval=45.0, **CALL_6A), xz(30.0, 30.0), world_6a(start=xz(30.0, 30.0)), WP_6A,
+        run_994(WorkpieceCall(cycle=994, mvar=1, setval=45.0, **CALL_6A), xz(30.0, 30.0), world_6a(start=xz(30.0, 30.0)), WP_6A,
                 diamon=True)
     assert err.value.definition is alarms.WRONG_VARIANT
     with pytest.raises(MeasuringError) as err:
-        run_994(Cycle994(mvar=2, setval=45.0, **{**CALL_6A, "szo": 50.0}), xz(30.0, 30.0),
+        run_994(WorkpieceCall(cycle=994, mvar=2, setval=45.0, **{**CALL_6A, "szo": 50.0}), xz(30.0, 30.0),
                 world_6a(start=xz(30.0, 30.0)), WP_6A, diamon=True)
     assert err.value.definition is alarms.PROTECTION_ZONE
 
@@ -324,7 +324,7 @@ def test_two_point_truth(radius, ex, angle, pm, pp, diamon):
     start = xz(radius + 8.0, 30.0)
     setval = 2 * radius if diamon else radius
     zone = radius + 6.0
-    call = Cycle994(mvar=2, setval=setval, ma=2, sza=60.0, szo=2 * zone if diamon else zone, fa=2.0, tsa=5.0,
+    call = WorkpieceCall(cycle=994, mvar=2, setval=setval, ma=2, sza=60.0, szo=2 * zone if diamon else zone, fa=2.0, tsa=5.0,
                     tdif=5.0)
     world = ProbeWorld(solids=[Solid(0.0, radius, -40.0, 50.0, ecc=(ex, 0.0))], radius={"X-": pm, "X+": pp},
                        true_r=3.0, start=start, angle=angle)
@@ -342,7 +342,7 @@ def test_two_point_on_z():
     start = xz(20.0, 30.0)
     world = ProbeWorld(solids=solids, radius={"Z-": 1.99, "Z+": 1.98}, true_r=2.0, start=start)
     ctx = LatheContext(tool=probe, wp=(LatheProbe(trigger={"Z-": 1.99, "Z+": -1.98}),), diamon=True)
-    call = Cycle994(mvar=2, setval=20.0, ma=1, szo=80.0, fa=1.0, tsa=1.0, tdif=1.0)
+    call = WorkpieceCall(cycle=994, mvar=2, setval=20.0, ma=1, szo=80.0, fa=1.0, tsa=1.0, tdif=1.0)
     point = drive(two_point_program(call, start, ctx), world)
     m = evaluate_two_point(call, point, ctx)
     assert m.actual == pytest.approx(20.0, abs=1e-9) and m.scale == 1.0
@@ -382,7 +382,7 @@ def test_7_complete_example():
     for (x, z), ma, setval, tul, tll, act, dev in points:
         start = xz(x / 2.0, z)
         world = ProbeWorld(solids=solids, radius=eff, true_r=3.0, start=start)
-        call = Cycle974(mvar=0, setval=setval, ma=ma, tul=tul, tll=tll, tzl=0.002, tdif=0.2, tsa=0.3, knum=1,
+        call = WorkpieceCall(cycle=974, mvar=0, setval=setval, ma=ma, tul=tul, tll=tll, tzl=0.002, tdif=0.2, tsa=0.3, knum=1,
                         tnum=len(found) + 1, fa=1.0)
         m = evaluate_point(call, drive(point_program(call, start, ctx), world), ctx)
         assert m.actual == pytest.approx(act, abs=1e-9) and m.deviation == pytest.approx(dev, abs=1e-9)
@@ -406,22 +406,22 @@ def test_point_checks():
     start = xz(45.0, 30.0)
     record = wp(**{"X-": 2.995})
     cases = [
-        (Cycle974(mvar=5, setval=45.0), {}, alarms.WRONG_VARIANT),
-        (Cycle974(mvar=0, setval=45.0, ma=3), {}, alarms.MEASURING_AXIS),
-        (Cycle974(mvar=0, setval=45.0, k=0.0, knum=1, tnum=7), {}, alarms.WEIGHTING_FACTOR),
-        (Cycle974(mvar=0, setval=45.0, knum=3001, tnum=7), {}, alarms.KNUM_DIGIT4),
-        (Cycle974(mvar=0, setval=45.0, knum=20001, tnum=7), {}, alarms.KNUM_DIGIT5),
-        (Cycle974(mvar=0, setval=45.0, knum=500001, tnum=7), {}, alarms.KNUM_DIGIT6),
-        (Cycle974(mvar=0, setval=45.0, knum=4000001, tnum=7), {}, alarms.KNUM_DIGIT7),
-        (Cycle974(mvar=0, setval=45.0, knum=1000, tnum=7), {}, alarms.D_NUMBER),
-        (Cycle974(mvar=0, setval=45.0, knum=1), {}, alarms.TOOL_NUMBER),
-        (Cycle974(mvar=0, setval=45.0, knum=1001001, tnum=7, dlnum=9), {}, alarms.DL_NUMBER),
-        (Cycle974(mvar=0, setval=45.0, knum=2100000), {}, alarms.TOOL_ENVIRONMENT),
-        (Cycle974(mvar=100, setval=45.0, knum=777), {}, alarms.ZO_NUMBER),
-        (Cycle974(mvar=1000, setval=45.0), {"spos": False}, alarms.NEEDS_SPOS),
-        (Cycle974(mvar=0, setval=45.0, prnum=2), {}, alarms.PROBE_NUMBER),
-        (Cycle974(mvar=0, setval=60.0, ma=2), {}, alarms.NOT_CALIBRATED_IN_PLANE),   # +X: _WP[0,4] = 0
-        (Cycle974(mvar=0, setval=45.0, ma=1), {}, alarms.CUTTING_EDGE_POSITION),     # start Z30 < 45: +Z
+        (WorkpieceCall(cycle=974, mvar=5, setval=45.0), {}, alarms.WRONG_VARIANT),
+        (WorkpieceCall(cycle=974, mvar=0, setval=45.0, ma=3), {}, alarms.MEASURING_AXIS),
+        (WorkpieceCall(cycle=974, mvar=0, setval=45.0, k=0.0, knum=1, tnum=7), {}, alarms.WEIGHTING_FACTOR),
+        (WorkpieceCall(cycle=974, mvar=0, setval=45.0, knum=3001, tnum=7), {}, alarms.KNUM_DIGIT4),
+        (WorkpieceCall(cycle=974, mvar=0, setval=45.0, knum=20001, tnum=7), {}, alarms.KNUM_DIGIT5),
+        (WorkpieceCall(cycle=974, mvar=0, setval=45.0, knum=500001, tnum=7), {}, alarms.KNUM_DIGIT6),
+        (WorkpieceCall(cycle=974, mvar=0, setval=45.0, knum=4000001, tnum=7), {}, alarms.KNUM_DIGIT7),
+        (WorkpieceCall(cycle=974, mvar=0, setval=45.0, knum=1000, tnum=7), {}, alarms.D_NUMBER),
+        (WorkpieceCall(cycle=974, mvar=0, setval=45.0, knum=1), {}, alarms.TOOL_NUMBER),
+        (WorkpieceCall(cycle=974, mvar=0, setval=45.0, knum=1001001, tnum=7, dlnum=9), {}, alarms.DL_NUMBER),
+        (WorkpieceCall(cycle=974, mvar=0, setval=45.0, knum=2100000), {}, alarms.TOOL_ENVIRONMENT),
+        (WorkpieceCall(cycle=974, mvar=100, setval=45.0, knum=777), {}, alarms.ZO_NUMBER),
+        (WorkpieceCall(cycle=974, mvar=1000, setval=45.0), {"spos": False}, alarms.NEEDS_SPOS),
+        (WorkpieceCall(cycle=974, mvar=0, setval=45.0, prnum=2), {}, alarms.PROBE_NUMBER),
+        (WorkpieceCall(cycle=974, mvar=0, setval=60.0, ma=2), {}, alarms.NOT_CALIBRATED_IN_PLANE),   # +X: _WP[0,4] = 0
+        (WorkpieceCall(cycle=974, mvar=0, setval=45.0, ma=1), {}, alarms.CUTTING_EDGE_POSITION),     # start Z30 < 45: +Z
     ]
     for call, kw, alarm in cases:
         ctx = LatheContext(tool=PROBE, wp=(record,), diamon=False, **kw)
@@ -433,7 +433,7 @@ def test_point_checks():
 def test_setup_sum_offsets():
     """_KNUM digit 7 = 1: the setup/sum offset _DLNUM (MM §2.3): _CHBIT[8]=0 into the sum offset."""
     start = xz(45.0, 30.0)
-    call = Cycle974(mvar=0, setval=45.0, **{**CALL_5B, "knum": 1001001, "dlnum": 2})
+    call = WorkpieceCall(cycle=974, mvar=0, setval=45.0, **{**CALL_5B, "knum": 1001001, "dlnum": 2})
     m, ctx, _ = run_974(call, start, od_world(22.5005, start), wp(**{"X-": 2.995}), ev=0.002, diamon=True)
     tool = {"t": 7, "type": 500, "sl": 3, "l1": 60.0, "l2": 30.0, "radius": 0.8,
             "dl": {2: {"setup": {"l1": 0.1}, "sum": {"l1": 0.02}}}}
@@ -462,11 +462,11 @@ def test_groove_calibration_then_measuring(skew_x, d_plus, d_minus, od, bore, di
     solids = [Solid(bore, od, -40.0, 60.0)]
     scale = 2.0 if diamon else 1.0
     for setval, s0, key in ((od * scale, od + 8.0, "X-"), (bore * scale, 0.5 * bore, "X+")):
-        call = Cycle974(mvar=0, setval=setval, ma=2, fa=1.5, tsa=5.0, tdif=5.0)
+        call = WorkpieceCall(cycle=974, mvar=0, setval=setval, ma=2, fa=1.5, tsa=5.0, tdif=5.0)
         world = ProbeWorld(solids=solids, radius=eff, true_r=3.0, skew=(0.0, skew_x), start=xz(s0, 30.0))
         m, _, _ = run_974(call, xz(s0, 30.0), world, record, diamon=diamon)
         assert m.actual == pytest.approx(setval, abs=1e-9), key
-    call = Cycle994(mvar=2, setval=od * scale, ma=2, sza=65.0, szo=(od + 5.0) * scale, fa=1.5, tsa=5.0, tdif=5.0)
+    call = WorkpieceCall(cycle=994, mvar=2, setval=od * scale, ma=2, sza=65.0, szo=(od + 5.0) * scale, fa=1.5, tsa=5.0, tdif=5.0)
     world = ProbeWorld(solids=[Solid(0.0, od, -40.0, 60.0)], radius=eff, true_r=3.0, skew=(0.0, skew_x),
                        start=xz(od + 8.0, 30.0))
     m, _, _ = run_994(call, xz(od + 8.0, 30.0), world, record, diamon=diamon)
