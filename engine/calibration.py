@@ -44,7 +44,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from engine import alarms
+from engine import alarms, checks
 from engine.compensation import centre_trigger_value
 from engine.frames import Frame, rot_z
 from engine.lobing import LobingMap, fit_lobing_map
@@ -427,14 +427,6 @@ class RingEstimate:
         }
 
 
-def _unit2(v: npt.ArrayLike) -> FloatArray:
-    u = np.asarray(v, dtype=float)
-    n = float(np.linalg.norm(u))
-    if not np.isfinite(n) or n == 0.0:
-        raise ValueError(f"direction must be a finite non-zero vector, got {u}")
-    return u / n
-
-
 def _classes(angles: FloatArray) -> tuple[FloatArray, FloatArray]:
     """(class angle per class, class index per touch), circular clustering within _ANGLE_TOL."""
     centres: list[float] = []
@@ -480,10 +472,10 @@ def _ring_design(touches: Sequence[RingTouch], plane: Plane, frame: str,
     theta, phis = np.empty(n), np.empty(n)
     for i, t in enumerate(touches):
         rec[i] = plane.to_aop(np.asarray(t.rec, dtype=float))[:2]
-        d_aop = plane.to_aop(_unit2(t.direction))
+        d_aop = plane.to_aop(checks.unit_vector(t.direction))
         if abs(d_aop[2]) > 1e-9:
             raise ValueError(f"ring touch {t.label or i} does not travel in the working plane")
-        d[i] = _unit2(d_aop[:2])
+        d[i] = checks.unit_vector(d_aop[:2])
         d_mcs = to_mcs(plane.to_xyz([d[i, 0], d[i, 1], 0.0]))
         dp_mcs = to_mcs(plane.to_xyz([-d[i, 1], d[i, 0], 0.0]))
         if abs(d_mcs[2]) > 1e-9:

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
+from engine import checks
 from engine.frames import Frame, rot_z
 from engine.planes import PLANES, Plane
 from engine.types import FloatArray, ProbeRecord, Touch
@@ -26,19 +27,9 @@ _AXES = ("X", "Y", "Z")
 _PARALLEL_TOL = 1e-9
 
 
-def _unit(direction: npt.ArrayLike) -> FloatArray:
-    d = np.asarray(direction, dtype=float)
-    if d.shape != (3,):
-        raise ValueError(f"direction must have shape (3,), got {d.shape}")
-    norm = float(np.linalg.norm(d))
-    if not np.isfinite(norm) or norm == 0.0:
-        raise ValueError(f"direction must be a finite non-zero vector, got {d}")
-    return d / norm
-
-
 def parallel_axis(direction_wcs: npt.ArrayLike) -> tuple[int, float] | None:
     """(axis index j, sign σ) when ``direction_wcs`` is axis-parallel within 1e-9, else None."""
-    d = _unit(direction_wcs)
+    d = checks.unit_vector(direction_wcs, dim=3)
     j = int(np.argmax(np.abs(d)))
     others = np.delete(d, j)
     if float(np.linalg.norm(others)) > _PARALLEL_TOL:
@@ -118,7 +109,7 @@ def make_touch(rec_wcs: npt.ArrayLike, direction_wcs: npt.ArrayLike, probe: Prob
         raise ValueError(f"rec_wcs must have shape (3,), got {rec.shape}")
     if lobing is None:
         lobing = probe.lobing
-    d_hat = _unit(direction_wcs)
+    d_hat = checks.unit_vector(direction_wcs, dim=3)
     skew = np.zeros(3) if skew_wcs is None else np.asarray(skew_wcs, dtype=float)
     centre = rec + skew
     if probe.length_to_tip:

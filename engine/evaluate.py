@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from engine import alarms
+from engine import alarms, checks
 from engine.compensation import trigger_radius
 from engine.correction import alpha_beta_from_normal
 from engine.fit import CircleFit, LineFit, fit_circle, fit_line, fit_plane, intersect_lines
@@ -86,14 +86,6 @@ def _fold90(deg: float) -> float:
 def _angle_ao(vec_ao: FloatArray | Sequence[float]) -> float:
     """Angle of a plane vector from the 1st plane axis, right-hand about the infeed (jog-measuring §0.1)."""
     return float(np.degrees(np.arctan2(vec_ao[1], vec_ao[0])))
-
-
-def _unit2(v: npt.ArrayLike) -> FloatArray:
-    u = np.asarray(v, dtype=float)
-    n = float(np.linalg.norm(u))
-    if n == 0.0:
-        raise ValueError("zero direction in the plane")
-    return u / n
 
 
 def _wants_angle(params: dict[str, Any], default: str) -> bool:
@@ -158,10 +150,10 @@ def circle_fit_of_touches(touches: Sequence[Touch], plane: Plane, kind: str, pro
         raise MeasuringError(alarms.CIRCLE_PARAMETERS, f"a circle needs 3 or more touches, got {len(touches)}")
     height = float(np.mean([plane.to_aop(t.surface)[2] for t in touches]))
     if len(touches) == 4:
-        u = _unit2(_ao(plane, touches[0].direction))
-        v = _unit2(_ao(plane, touches[2].direction))
-        d1 = _unit2(_ao(plane, touches[1].direction))
-        d3 = _unit2(_ao(plane, touches[3].direction))
+        u = checks.unit_vector(_ao(plane, touches[0].direction))
+        v = checks.unit_vector(_ao(plane, touches[2].direction))
+        d1 = checks.unit_vector(_ao(plane, touches[1].direction))
+        d3 = checks.unit_vector(_ao(plane, touches[3].direction))
         if abs(u @ v) < 1e-9 and np.allclose(d1, -u, atol=1e-9) and np.allclose(d3, -v, atol=1e-9):
             s = [_ao(plane, t.surface) for t in touches]
             centre_u = 0.5 * (s[0] + s[1]) @ u          # jog-measuring §8.3 centre_a = (s1 + s2)/2
@@ -195,7 +187,7 @@ def rect_from_touches(touches: Sequence[Touch], plane: Plane, kind: str
     s = [_ao(plane, t.surface) for t in touches]
     pairs = []
     for i, j in ((0, 1), (2, 3)):
-        u = _unit2(_ao(plane, touches[i].direction))
+        u = checks.unit_vector(_ao(plane, touches[i].direction))
         span = (s[i] - s[j]) @ u                           # jog-measuring §8.3 inner: s1 − s2
         span = span if kind == "pocket" else -span         # outer: s2 − s1
         if span <= 0.0:
@@ -377,8 +369,8 @@ def evaluate_corner(task: str, params: dict[str, Any], points: Sequence[StoredPo
         values["angle_2"] = _angle_ao(line2.direction)
         # the angle between the two edges as they leave the corner towards their points
         # (jog-measuring §2.6.2): e.g. 105° for a 105° corner, not its supplement
-        u1 = _unit2(np.mean(q12, axis=0) - corner)
-        u2 = _unit2(np.mean(q34, axis=0) - corner)
+        u1 = checks.unit_vector(np.mean(q12, axis=0) - corner)
+        u2 = checks.unit_vector(np.mean(q34, axis=0) - corner)
         values["corner_angle"] = float(np.degrees(np.arccos(np.clip(u1 @ u2, -1.0, 1.0))))
     fix = FeatureFix(position=_plane_point(plane, corner), angle=angle, angle_axis=plane.infeed,
                      reference_axis=plane.first, point=corner_xyz)

@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from engine import alarms
+from engine import alarms, checks
 from engine.types import FloatArray, MeasuringError
 
 # Relative tolerance for degeneracy: a singular value below REL_EPS * (largest extent) counts as 0.
@@ -59,11 +59,6 @@ def _extent(centred: FloatArray) -> float:
 
 def _empty() -> FloatArray:
     return np.zeros(0)
-
-
-def _check_sigma(sigma: float | None) -> None:
-    if sigma is not None and not (np.isfinite(sigma) and sigma >= 0.0):
-        raise ValueError(f"sigma must be a finite value >= 0, got {sigma}")
 
 
 def _quality(residuals: FloatArray, jac: FloatArray, sigma: float | None
@@ -148,7 +143,8 @@ def fit_circle(points_2d: npt.ArrayLike, *, sigma: float | None = None) -> Circl
     both exact for points on a circle. Fewer than 3 points -> 61317; collinear or coincident
     points -> 61316. ``sigma``: a-priori σ per point for the covariance (module docstring).
     """
-    _check_sigma(sigma)
+    if sigma is not None:
+        checks.real("sigma", sigma, minimum=0.0)
     pts = _as_points(points_2d, 2, "points_2d")
     if len(pts) < 3:
         raise MeasuringError(alarms.CIRCLE_PARAMETERS, f"circle needs 3 or more points, got {len(pts)}")
@@ -242,7 +238,8 @@ def fit_line(points_2d: npt.ArrayLike, *, sigma: float | None = None) -> LineFit
     P_first -> P_last, so for two points it is the unit vector of P1 -> P2. Fewer than 2 points
     or all points coincident -> 61367 ("points identical"). ``sigma``: a-priori σ per point.
     """
-    _check_sigma(sigma)
+    if sigma is not None:
+        checks.real("sigma", sigma, minimum=0.0)
     pts = _as_points(points_2d, 2, "points_2d")
     if len(pts) < 2:
         raise MeasuringError(alarms.POINTS_IDENTICAL, f"a line needs 2 or more points, got {len(pts)}")
@@ -320,7 +317,8 @@ def fit_plane(points_3d: npt.ArrayLike, *, sigma: float | None = None) -> PlaneF
     points (callers orient it, e.g. to +infeed). Fewer than 3 points, or collinear/coincident
     points -> 61411. ``sigma``: a-priori σ per point.
     """
-    _check_sigma(sigma)
+    if sigma is not None:
+        checks.real("sigma", sigma, minimum=0.0)
     pts = _as_points(points_3d, 3, "points_3d")
     if len(pts) < 3:
         raise MeasuringError(alarms.FRAME_IMPOSSIBLE, f"a plane needs 3 or more points, got {len(pts)}")
@@ -412,7 +410,8 @@ def fit_sphere(points_3d: npt.ArrayLike, *, radius: float | None = None, center0
     Failures: too few points -> 61317; coplanar (free radius) / collinear points, no ``center0``
     where one is needed, or no convergence -> 61316; ``radius`` <= 0 -> 61413.
     """
-    _check_sigma(sigma)
+    if sigma is not None:
+        checks.real("sigma", sigma, minimum=0.0)
     pts = _as_points(points_3d, 3, "points_3d")
     fixed = radius is not None
     if radius is not None and not (np.isfinite(radius) and radius > 0.0):

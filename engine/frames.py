@@ -16,18 +16,10 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from engine import checks
 from engine.types import FloatArray
 
 GEOMETRY_AXES = ("X", "Y", "Z")
-
-
-def _vec3(value: npt.ArrayLike, name: str) -> FloatArray:
-    arr = np.array(value, dtype=float)          # a copy: the frame owns (and freezes) it
-    if arr.shape != (3,):
-        raise ValueError(f"{name} must have shape (3,), got {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} must be finite, got {arr}")
-    return arr
 
 
 def rot_x(deg: float) -> FloatArray:
@@ -55,7 +47,7 @@ def rot_axis(axis: str, deg: float) -> FloatArray:
 
 def matrix_from_rpy(rot_deg: npt.ArrayLike) -> FloatArray:
     """R = Rz(c)·Ry(b)·Rx(a) for rot_deg = (a about X, b about Y, c about Z) (design.md §3 RPY)."""
-    a, b, c = _vec3(rot_deg, "rot_deg")
+    a, b, c = checks.vector(rot_deg, "rot_deg")
     return rot_z(c) @ rot_y(b) @ rot_x(a)
 
 
@@ -91,7 +83,7 @@ class Frame:
 
     def __post_init__(self) -> None:
         for name in ("coarse", "fine", "rot"):
-            value = _vec3(getattr(self, name), name)
+            value = checks.vector(getattr(self, name), name)
             value.flags.writeable = False            # a value object (frames are shared, see _frame_of)
             object.__setattr__(self, name, value)
         rotary = tuple(sorted((str(k), float(v)) for k, v in dict(self.rotary).items()))
@@ -110,7 +102,7 @@ class Frame:
     def from_matrix(cls, rotation: npt.ArrayLike, translation: npt.ArrayLike,
                     rotary: Mapping[str, float] | None = None) -> Frame:
         """Frame with coarse translation ``translation`` and rotation ``rotation`` (3x3)."""
-        return cls(coarse=_vec3(translation, "translation"), rot=rpy_from_matrix(rotation),
+        return cls(coarse=checks.vector(translation, "translation"), rot=rpy_from_matrix(rotation),
                    rotary=tuple((rotary or {}).items()))
 
     def replace(self, **changes: Any) -> Frame:

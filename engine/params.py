@@ -9,52 +9,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import Any, Literal, overload
+from typing import Any
 
-from engine.plan_base import ParamError
+from engine.checks import ParamError, param_choice, param_number, param_positive
 from engine.planes import Plane
 
 ROTARY_AXES = ("A", "B", "C")   # design.md §3: optional rotary axes
 MAX_MAGNITUDE = 100_000.0       # mm/deg: no measuring quantity beyond the offset limits (design.md §9.1)
 
 ParamsValidator = Callable[[str, dict[str, Any], Plane], dict[str, Any]]   # (variant, params, plane)
-
-
-@overload
-def _number(params: dict[str, Any], name: str, default: object = None, *, required: Literal[True]) -> float: ...
-@overload
-def _number(params: dict[str, Any], name: str, default: object = None, *, required: bool = False) -> float | None: ...
-def _number(params: dict[str, Any], name: str, default: object = None, *, required: bool = False) -> float | None:
-    value = params.get(name, default)
-    if value is None or value == "":
-        if required:
-            raise ParamError(name, f"{name} is required")
-        return None
-    if isinstance(value, bool):
-        raise ParamError(name, f"{name} must be a number, got {value!r}")
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ParamError(name, f"{name} must be a number, got {value!r}") from None
-    if not math.isfinite(number):
-        raise ParamError(name, f"{name} must be a finite number, got {value!r}")
-    if abs(number) > MAX_MAGNITUDE:
-        raise ParamError(name, f"{name} must lie within ±{MAX_MAGNITUDE:g}, got {value!r}")
-    return number
-
-
-def _positive(params: dict[str, Any], name: str, *, required: bool) -> float | None:
-    value = _number(params, name, required=required)
-    if value is not None and value <= 0.0:
-        raise ParamError(name, f"{name} must be > 0, got {value:g}")
-    return value
-
-
-def _choice(params: dict[str, Any], name: str, choices: tuple[str, ...], default: str) -> str:
-    value = params.get(name, default)
-    if value not in choices:
-        raise ParamError(name, f"{name} must be one of {', '.join(map(str, choices))}, got {value!r}")
-    return str(value)
 
 
 def _axis(params: dict[str, Any], name: str, default: str) -> str:
@@ -73,7 +36,7 @@ def _setpoint_axis(params: dict[str, Any], axis: str) -> dict[str, float]:
         if extra:
             raise ParamError(f"setpoint.{extra[0]}", f"setpoint may only give the {axis} value")
         value = value.get(axis, 0.0)
-    return {axis: _number({f"setpoint.{axis}": value}, f"setpoint.{axis}", 0.0) or 0.0}   # empty = 0
+    return {axis: param_number({f"setpoint.{axis}": value}, f"setpoint.{axis}", 0.0, bound=MAX_MAGNITUDE) or 0.0}   # empty = 0
 
 
 def _setpoint_point(params: dict[str, Any], plane: Plane) -> dict[str, float]:
@@ -83,7 +46,7 @@ def _setpoint_point(params: dict[str, Any], plane: Plane) -> dict[str, float]:
         raise ParamError("setpoint", "setpoint must be an object keyed by the plane's axis names")
     out = {}
     for axis in (plane.first, plane.second):
-        out[axis] = _number({f"setpoint.{axis}": value.get(axis, 0.0)}, f"setpoint.{axis}", 0.0) or 0.0
+        out[axis] = param_number({f"setpoint.{axis}": value.get(axis, 0.0)}, f"setpoint.{axis}", 0.0, bound=MAX_MAGNITUDE) or 0.0
     for key in value:
         if key not in out:
             raise ParamError(f"setpoint.{key}", f"setpoint axis {key!r} is not an axis of the plane {plane.name}")
@@ -101,11 +64,10 @@ def _angle_correction(params: dict[str, Any], allowed_none: bool, default: str) 
 
 
 def _setpoint_angle(params: dict[str, Any]) -> float:
-    value = _number(params, "setpoint_angle", 0.0) or 0.0     # empty field = 0 (jog-measuring §2.3)
+    value = param_number(params, "setpoint_angle", 0.0, bound=MAX_MAGNITUDE) or 0.0     # empty field = 0 (jog-measuring §2.3)
     if not -360.0 < value < 360.0:      # jog-measuring §2.3 [I]: setpoint angle in (−360, 360)
         raise ParamError("setpoint_angle", f"setpoint_angle must lie in (-360, 360), got {value:g}")
     return value
-
 
 
 def _passthrough_target(params: dict[str, Any], out: dict[str, Any]) -> dict[str, Any]:
@@ -117,7 +79,7 @@ def _passthrough_target(params: dict[str, Any], out: dict[str, Any]) -> dict[str
 def validate_edge(variant: str, params: dict[str, Any], plane: Plane) -> dict[str, Any]:
     """Set edge / align edge / distance 2 edges (jog-measuring §2.5)."""
     out: dict[str, Any] = {"axis": _axis(params, "axis", plane.second if variant == "align" else plane.first),
-                 "direction": _choice(params, "direction", ("+", "-"), "+")}
+                 "direction": param_choice(params, "direction", ("+", "-"), "+")}
     if variant == "align":
         others = tuple(a for a in (plane.first, plane.second) if a != out["axis"])
         ref = _axis(params, "reference_axis", others[0])
@@ -131,15 +93,15 @@ def validate_edge(variant: str, params: dict[str, Any], plane: Plane) -> dict[st
     else:
         if variant == "distance":
             opposite = "-" if out["direction"] == "+" else "+"
-            out["direction_p2"] = _choice(params, "direction_p2", ("+", "-"), opposite)
+            out["direction_p2"] = param_choice(params, "direction_p2", ("+", "-"), opposite)
         out["setpoint"] = _setpoint_axis(params, out["axis"])
     return _passthrough_target(params, out)
 
 
 def validate_corner(variant: str, params: dict[str, Any], plane: Plane) -> dict[str, Any]:
     """Right-angled / any corner (jog-measuring §2.6)."""
-    out: dict[str, Any] = {"kind": _choice(params, "kind", ("outside", "inside"), "outside")}
-    position = _number(params, "position", 1)
+    out: dict[str, Any] = {"kind": param_choice(params, "kind", ("outside", "inside"), "outside")}
+    position = param_number(params, "position", 1, bound=MAX_MAGNITUDE)
     if position not in (1.0, 2.0, 3.0, 4.0):
         raise ParamError("position", f"position must be 1, 2, 3 or 4, got {params.get('position')!r}")
     out["position"] = int(position)
@@ -150,10 +112,10 @@ def validate_corner(variant: str, params: dict[str, Any], plane: Plane) -> dict[
 def validate_rect(spigot: bool) -> ParamsValidator:
     """Rectangular pocket (``spigot`` False) or spigot (jog-measuring §2.7.1, jog-measuring §2.8)."""
     def validate(variant: str, params: dict[str, Any], plane: Plane) -> dict[str, Any]:
-        out: dict[str, Any] = {"length": _positive(params, "length", required=spigot),
-                     "width": _positive(params, "width", required=spigot)}
+        out: dict[str, Any] = {"length": param_positive(params, "length", required=spigot, bound=MAX_MAGNITUDE),
+                     "width": param_positive(params, "width", required=spigot, bound=MAX_MAGNITUDE)}
         if spigot:
-            out["infeed"] = _positive(params, "infeed", required=True)
+            out["infeed"] = param_positive(params, "infeed", required=True, bound=MAX_MAGNITUDE)
         out["setpoint"] = _setpoint_point(params, plane)
         return _passthrough_target(params, out)
     return validate
@@ -201,10 +163,10 @@ def _check_circle_angles(angles: Any) -> None:
 def validate_circles(spigot: bool) -> ParamsValidator:
     """1..4 holes (``spigot`` False) or circular spigots (jog-measuring §2.7, jog-measuring §2.8); ``variant`` = count."""
     def validate(variant: str, params: dict[str, Any], plane: Plane) -> dict[str, Any]:
-        out: dict[str, Any] = {"diameter": _positive(params, "diameter", required=spigot)}  # hole: may be empty
+        out: dict[str, Any] = {"diameter": param_positive(params, "diameter", required=spigot, bound=MAX_MAGNITUDE)}  # hole: may be empty
         if spigot:
-            out["infeed"] = _positive(params, "infeed", required=True)
-        out["probe_angle"] = _number(params, "probe_angle", 0.0) or 0.0
+            out["infeed"] = param_positive(params, "infeed", required=True, bound=MAX_MAGNITUDE)
+        out["probe_angle"] = param_number(params, "probe_angle", 0.0, bound=MAX_MAGNITUDE) or 0.0
         if variant in ("2", "3", "4"):
             out["angle_correction"] = _angle_correction(params, variant != "2",
                                                         "rotation" if variant == "2" else "none")
@@ -233,18 +195,18 @@ def validate_probe_length(variant: str, params: dict[str, Any], plane: Plane) ->
 def validate_probe_radius(variant: str, params: dict[str, Any], plane: Plane) -> dict[str, Any]:
     """Calibrate radius (jog-measuring §5.3): the ring gauge's diameter; optionally the number of probing
     directions per pass and the offset of off-centre chords (engine.plan_workpiece.ring_program)."""
-    out: dict[str, Any] = {"diameter": _positive(params, "diameter", required=True)}
+    out: dict[str, Any] = {"diameter": param_positive(params, "diameter", required=True, bound=MAX_MAGNITUDE)}
     if params.get("points") not in (None, ""):            # design.md §10.2: the touches per pass
         if params.get("directions") not in (None, "", params["points"]):
             raise ParamError("points", "give points or directions, not both")
         params = {**params, "directions": params["points"]}
     if params.get("directions") not in (None, ""):
-        n = _number(params, "directions", required=True)     # given: never None
+        n = param_number(params, "directions", required=True, bound=MAX_MAGNITUDE)     # given: never None
         if n != int(n) or not 4 <= n <= 36:
             raise ParamError("directions", f"directions must be a whole number 4..36, got {params['directions']!r}")
         out["directions"] = int(n)
     if params.get("chord_offset") not in (None, ""):
-        h = _number(params, "chord_offset", required=True)   # given: never None
+        h = param_number(params, "chord_offset", required=True, bound=MAX_MAGNITUDE)   # given: never None
         if h < 0.0 or h >= 0.45 * out["diameter"]:
             raise ParamError("chord_offset", f"chord_offset must lie in [0, {0.45 * out['diameter']:g}) mm")
         out["chord_offset"] = h
@@ -253,15 +215,15 @@ def validate_probe_radius(variant: str, params: dict[str, Any], plane: Plane) ->
 
 def validate_toolprobe(variant: str, params: dict[str, Any], plane: Plane) -> dict[str, Any]:
     """Calibrate the tool probe (jog-measuring §7.2)."""
-    return _passthrough_target(params, {"mode": _choice(params, "mode", ("length", "length_diameter"),
+    return _passthrough_target(params, {"mode": param_choice(params, "mode", ("length", "length_diameter"),
                                                         "length")})
 
 
 def validate_tool(variant: str, params: dict[str, Any], plane: Plane) -> dict[str, Any]:
     """Tool length / diameter (jog-measuring §7.3): offset V and geometry or wear (_JM_B[0])."""
-    value = _number(params, "offset_v", 0.0) or 0.0
+    value = param_number(params, "offset_v", 0.0, bound=MAX_MAGNITUDE) or 0.0
     if value < 0.0:
         raise ParamError("offset_v", f"offset_v must be >= 0, got {value:g}")
     out: dict[str, Any] = {"offset_v": value,
-                 "compensation": _choice(params, "compensation", ("geometry", "wear"), "geometry")}
+                 "compensation": param_choice(params, "compensation", ("geometry", "wear"), "geometry")}
     return _passthrough_target(params, out)

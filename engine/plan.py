@@ -14,8 +14,8 @@ from typing import Any
 
 import numpy as np
 
+from engine.checks import ParamError
 from engine.plan_base import (
-    ParamError,
     PlanContext,
     RingCalibrationPoint,
     RingPass,

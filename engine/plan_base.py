@@ -1,6 +1,6 @@
 """Planning contracts and the common probing execution (spec/jog-measuring.md §2.4).
 
-``PlanContext``, ``ParamError``, the stored points of calibration and tool
+``PlanContext`` (``ParamError`` is engine.checks'), the stored points of calibration and tool
 tasks, and ``Motion``: the positioning/probing helper every point program uses. Re-exported
 by ``engine.plan`` (the public module).
 """
@@ -77,15 +77,6 @@ class PlanContext:
         """The workpiece probe record; NoProbeRecord when there is none (a tool task's context
         has none: it measures a cutter)."""
         return probe_record(self.probe_record, "planning a workpiece probing")
-
-
-class ParamError(ValueError):
-    """An invalid task parameter; ``field`` names it, the message names the problem."""
-
-    def __init__(self, field: str, message: str):
-        super().__init__(message)
-        self.field = field
-        self.message = message
 
 
 # --- stored points of calibration and tool tasks (raw data in, not results) ---------------

@@ -23,14 +23,11 @@ to within 1e-9". Below the measuring resolution of any machine, so it only pins 
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, fields, replace
-from typing import Any, TypeGuard, cast
+from typing import Any, cast
 
-import numpy as np
-
-from engine import alarms
+from engine import alarms, checks
 from engine.alarms import AlarmDef
 from engine.types import MeasuringError
 
@@ -53,36 +50,15 @@ _EVNUM_MAX = 9999_9999        # manual §2.3.14: MV in the upper 4 digits, EV in
 
 # --- small helpers ---------------------------------------------------------------------------
 
-def _is_number(value: object) -> TypeGuard[int | float | np.integer[Any] | np.floating[Any]]:
-    return isinstance(value, int | float | np.integer | np.floating) and not isinstance(value, bool)
-
-
-def _real(name: str, value: object) -> float:
-    """A finite real number; ``name`` is the field named in the error (JSON booleans are not numbers)."""
-    if not _is_number(value):
-        raise ValueError(f"{name} must be a number, got {value!r}")
-    out = float(value)
-    if not math.isfinite(out):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    return out
-
-
-def _integer(name: str, value: object) -> int:
-    """An integer (an integral float such as 3.0 is accepted, 2.5 and booleans are not)."""
-    out = _real(name, value)
-    if out != int(out):
-        raise ValueError(f"{name} must be an integer, got {value!r}")
-    return int(out)
-
 
 def average(values: object) -> float:
     """Arithmetic mean of the _NMSP measurements at the same point: D = (S1 + … + Sn)/n.
 
     manual §2.3.15, measuring-math §1.4 (seed 000 R27). A single number is returned as it is.
     """
-    if _is_number(values):
-        return _real("actual", values)
-    arr = [_real("actual", v) for v in cast(Iterable[object], values)]   # not a number: a sequence
+    if checks.is_number(values):
+        return checks.real("actual", values)
+    arr = [checks.real("actual", v) for v in cast(Iterable[object], values)]   # not a number: a sequence
     if not arr:
         raise ValueError("actual: at least one measurement is needed (_NMSP >= 1)")
     return float(sum(arr) / len(arr))
@@ -97,7 +73,7 @@ def _check_weighting(k: object) -> int:
     the NC happily holds, so it is a legal input the cycle refuses, like any other cycle alarm.
     A non-integer _K cannot be held by the INT parameter at all, that is a ValueError.
     """
-    value = _integer("k", k)
+    value = checks.integer("k", k)
     if value < 1:
         raise MeasuringError(alarms.WEIGHTING_FACTOR, f"k (_K) = {value}: the weighting factor must be >= 1")
     return value
@@ -136,7 +112,7 @@ def decode_evnum(evnum: object, sizes: tuple[int, int] | None = (20, 20)) -> Mem
     MV 9 (_MV[8]). ``sizes`` = _EVMVNUM[0], [1] (array sizes, default 20 each); a memory beyond
     them is a ValueError (the manual lists no alarm for it); None = unchecked.
     """
-    n = _integer("evnum", evnum)
+    n = checks.integer("evnum", evnum)
     if n < 0 or n > _EVNUM_MAX:
         raise ValueError(f"evnum must be 0…{_EVNUM_MAX}, got {evnum!r}")
     if n == 0:
@@ -190,7 +166,7 @@ class Tolerance:
     def __post_init__(self) -> None:
         for name in ("setpoint", "upper", "lower", "zero_range", "mean_range", "dim_difference",
                      "safe_area", "distortion_limit"):
-            object.__setattr__(self, name, _real(name, getattr(self, name)))
+            object.__setattr__(self, name, checks.real(name, getattr(self, name)))
         if not isinstance(self.keep_mean, bool):
             raise ValueError(f"keep_mean must be true or false, got {self.keep_mean!r}")
         if self.safe_area == 0.0:
@@ -199,7 +175,7 @@ class Tolerance:
             raise ValueError("dim_difference (_TDIF) must not be 0")
         if self.upper < self.lower:
             raise ValueError(f"upper (_TUL = {self.upper:g}) must not be below lower (_TLL = {self.lower:g})")
-        object.__setattr__(self, "evnum", _integer("evnum", self.evnum))
+        object.__setattr__(self, "evnum", checks.integer("evnum", self.evnum))
         decode_evnum(self.evnum, sizes=None)
         object.__setattr__(self, "k", _check_weighting(self.k))
 
@@ -277,8 +253,8 @@ def mean_value(mv_old: float, deviation: float, k: object) -> float:
     _NMSP); ``mv_old`` the mean before this measurement (0 after a compensation). k = 1 → D_i.
     """
     weight = _check_weighting(k)
-    mv_old = _real("mv_old", mv_old)
-    deviation = _real("deviation", deviation)
+    mv_old = checks.real("mv_old", mv_old)
+    deviation = checks.real("deviation", deviation)
     return mv_old - (mv_old - deviation) / weight
 
 
@@ -342,8 +318,8 @@ def _memory_values(tolerance: Tolerance, ev: object, mv_old: object) -> tuple[fl
     """(EV, Mv_old, MV memory in use). A value for a memory _EVNUM does not select is a caller
     error. With _CHBIT[4]=0 the previous mean is 0 and nothing is stored (measuring-math §3.3 [I], measuring-math §17 Q9)."""
     memories = tolerance.memories
-    ev_value = _real("ev", ev)
-    mv_value = _real("mv_old", mv_old)
+    ev_value = checks.real("ev", ev)
+    mv_value = checks.real("mv_old", mv_old)
     if memories.ev is None and ev_value != 0.0:
         raise ValueError(f"ev = {ev_value:g} given, but evnum = {tolerance.evnum} selects no EV memory")
     if memories.mv is None and mv_value != 0.0:
@@ -443,7 +419,7 @@ def repeat_measurement(violation: str | None, repetitions_done: int, *, repeat: 
       61306 (abort) where the alarm list gives it for the cycle (``abort_after_repeats``: 971,
       972, 974, 977, 978, 979, 982), else 62306 (continue, e.g. CYCLE994) (measuring-math §3.6 [I], measuring-math §17 Q11).
     """
-    done = _integer("repetitions_done", repetitions_done)
+    done = checks.integer("repetitions_done", repetitions_done)
     if done < 0 or done > MAX_REPETITIONS:
         raise ValueError(f"repetitions_done must be 0…{MAX_REPETITIONS}, got {repetitions_done!r}")
     if violation is None:
@@ -508,9 +484,9 @@ def decide_tool_measurement(measured: object, geometry: float, wear: float, tole
     else _CHBIT[3]=0: geometry := value, wear := 0;  _CHBIT[3]=1: wear += Δ       (measuring-math §14.4)
     """
     raw = average(measured)
-    geometry = _real("geometry", geometry)
-    wear = _real("wear", wear)
-    ev = _real("ev", ev)
+    geometry = checks.real("geometry", geometry)
+    wear = checks.real("wear", wear)
+    ev = checks.real("ev", ev)
     if tolerance.memories.ev is None and ev != 0.0:
         raise ValueError(f"ev = {ev:g} given, but evnum = {tolerance.evnum} selects no EV memory")
     value = _apply_ev(raw, ev, bool(ev_add))
@@ -577,8 +553,8 @@ def decide_calibration(new: Mapping[str, float], old: Mapping[str, float] | None
     incremental tool-probe calibration, no _TZL/_TSA (manual §5.2.3, turning §0.11).
     """
     old = dict(old or {})
-    new_values = {str(key): _real(f"new[{key}]", value) for key, value in new.items()}
-    old_values = {str(key): _real(f"old[{key}]", value) for key, value in old.items()}
+    new_values = {str(key): checks.real(f"new[{key}]", value) for key, value in new.items()}
+    old_values = {str(key): checks.real(f"old[{key}]", value) for key, value in old.items()}
     delta = {key: value - old_values.get(key, 0.0) for key, value in new_values.items()}
     warnings: list[str] = []
     zeroed = all(old_values.get(key, 0.0) == 0.0 for key in new_values)
@@ -629,19 +605,19 @@ def decide_zero_offset(actual: float | Sequence[float], setpoint: float | Sequen
     sequences per axis (e.g. a centre): any |d_i| > |_TSA| → 61303, nothing corrected;
     otherwise 100 % of d into the frame. No _TZL, no mean.
     """
-    tsa = _real("safe_area", safe_area)
+    tsa = checks.real("safe_area", safe_area)
     if tsa == 0.0:
         raise ValueError("safe_area (_TSA) must not be 0")
-    ev = _real("ev", ev)
-    if _is_number(actual):
-        d = _apply_ev(_real("actual", actual), ev, bool(ev_add)) - _real("setpoint", setpoint)
+    ev = checks.real("ev", ev)
+    if checks.is_number(actual):
+        d = _apply_ev(checks.real("actual", actual), ev, bool(ev_add)) - checks.real("setpoint", setpoint)
         if abs(d) > abs(tsa) + EPS:
             return ZeroOffsetDecision(deviation=d, decision="safe_area", corrected=0.0,
                                       alarm=alarms.SAFE_AREA, violation="safe_area", abort=True)
         return ZeroOffsetDecision(deviation=d, decision="full", corrected=d, alarm=None, violation=None)
-    acts = [_real("actual", a) for a in cast(Sequence[object], actual)]     # not a number: per axis
-    sets = ([_real("setpoint", setpoint)] * len(acts) if _is_number(setpoint)
-            else [_real("setpoint", s) for s in cast(Sequence[object], setpoint)])
+    acts = [checks.real("actual", a) for a in cast(Sequence[object], actual)]     # not a number: per axis
+    sets = ([checks.real("setpoint", setpoint)] * len(acts) if checks.is_number(setpoint)
+            else [checks.real("setpoint", s) for s in cast(Sequence[object], setpoint)])
     if len(sets) != len(acts) or not acts:
         raise ValueError("actual and setpoint must have the same, non-zero length")
     ds = tuple(_apply_ev(a, ev, bool(ev_add)) - s for a, s in zip(acts, sets, strict=True))

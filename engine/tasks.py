@@ -21,7 +21,8 @@ from typing import Any
 
 from engine import evaluate as ev
 from engine import params as pv
-from engine.plan_base import ParamError, PlanContext
+from engine.checks import ParamError
+from engine.plan_base import PlanContext
 from engine.plan_tool import tool_diameter_program, tool_length_program, toolprobe_program
 from engine.plan_workpiece import (
     Program,

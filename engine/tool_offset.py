@@ -48,13 +48,11 @@ wear + c, wear := 0. Setup/sum offsets (_DLNUM, _CHBIT[8]) are not part of this 
 from __future__ import annotations
 
 import copy
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-
+from engine import checks
 from engine.strategy import Decision
 
 __all__ = ["FEATURES", "ToolOffsetUpdate", "apply_compensation", "compensation_value",
@@ -66,21 +64,6 @@ _WIDTH_SIGN = {"bore": 1, "slot": 1, "inner_rectangle": 1,
 FEATURES = ("surface", *_WIDTH_SIGN)
 _CORRECT = ("radius", "length")
 _MODES = ("wear", "geometry")
-
-
-def _real(name: str, value: object) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
-        raise ValueError(f"{name} must be a number, got {value!r}")
-    out = float(value)
-    if not math.isfinite(out):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    return out
-
-
-def _unit_sign(name: str, value: int) -> int:
-    if isinstance(value, bool) or value not in (1, -1):
-        raise ValueError(f"{name} must be +1 or −1, got {value!r}")
-    return int(value)
 
 
 def compensation_value(feature: str, amount: float, correct: str = "radius", *, direction: int | None = None,
@@ -99,14 +82,14 @@ def compensation_value(feature: str, amount: float, correct: str = "radius", *, 
         raise ValueError(f"feature must be one of {', '.join(FEATURES)}, got {feature!r}")
     if correct not in _CORRECT:
         raise ValueError(f"correct must be 'radius' or 'length', got {correct!r}")
-    a = _real("amount", amount)
+    a = checks.real("amount", amount)
     if amount_is_diameter is None:
         amount_is_diameter = feature != "surface"
     if not isinstance(amount_is_diameter, bool):
         raise ValueError(f"amount_is_diameter must be true or false, got {amount_is_diameter!r}")
     half = a / 2.0 if amount_is_diameter else a            # radius-scaled |Δ| (measuring-math §2.3 halving)
     if direction is not None:
-        direction = _unit_sign("direction", direction)
+        direction = checks.unit_sign("direction", direction)
     if feature == "surface":
         delta = half                                       # Δ of the probed surface
         if correct == "length":
@@ -114,7 +97,7 @@ def compensation_value(feature: str, amount: float, correct: str = "radius", *, 
         else:
             if direction is None:
                 raise ValueError("a radius correction from a 1-point surface needs the probe's direction")
-            c = _unit_sign("direction", direction) * delta   # measuring-math §2.3: c = σ·D
+            c = checks.unit_sign("direction", direction) * delta   # measuring-math §2.3: c = σ·D
     else:
         m = _WIDTH_SIGN[feature]
         if correct == "radius":
@@ -123,7 +106,7 @@ def compensation_value(feature: str, amount: float, correct: str = "radius", *, 
             if side is None:
                 raise ValueError(f"a length offset does not resize a milled {feature}: a length "
                                  "correction from a width needs the side (±1) of a turned feature")
-            c = -_unit_sign("side", side) * half           # turning §0.11 CYCLE994: c = −Δ
+            c = -checks.unit_sign("side", side) * half           # turning §0.11 CYCLE994: c = −Δ
     if not isinstance(inverse, bool):
         raise ValueError(f"inverse must be true or false, got {inverse!r}")
     return -c if inverse else c                            # manual §2.3.4 digit 5: sign reversed
@@ -140,9 +123,9 @@ def _tool_copy(tool: Mapping[str, Any]) -> dict[str, Any]:
         raise ValueError(f"tool wear must be a mapping, got {type(wear).__name__}")
     wear = dict(wear)
     for key in _CORRECT:
-        wear[key] = _real(f"wear.{key}", wear.get(key, 0.0))
+        wear[key] = checks.real(f"wear.{key}", wear.get(key, 0.0))
         if key in out:
-            out[key] = _real(key, out[key])
+            out[key] = checks.real(key, out[key])
     out["wear"] = wear
     return out
 
@@ -158,7 +141,7 @@ def apply_compensation(tool: Mapping[str, Any], compensation: float, correct: st
         raise ValueError(f"correct must be 'radius' or 'length', got {correct!r}")
     if mode not in _MODES:
         raise ValueError(f"mode must be 'wear' or 'geometry', got {mode!r}")
-    c = _real("compensation", compensation)
+    c = checks.real("compensation", compensation)
     after = _tool_copy(tool)
     if mode == "wear":
         after["wear"][correct] = after["wear"][correct] + c

@@ -18,7 +18,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from engine import alarms
+from engine import alarms, checks
 from engine.turning import LENGTH_OF_AXIS, LatheTool, index
 from engine.types import MeasuringError
 
@@ -41,11 +41,6 @@ def tool_dict(tool: LatheTool | Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
-def _check_quantity(quantity: str) -> None:
-    if quantity not in QUANTITIES:
-        raise ValueError(f"quantity must be one of {', '.join(QUANTITIES)}, got {quantity!r}")
-
-
 # --- CYCLE972/982 (turning.md §2.4, turning §0.11) ----------------------------------------------------
 
 def tool_measure_update(tool: LatheTool | Mapping[str, Any], quantity: str, measured: float, *, remeasure: bool,
@@ -57,7 +52,7 @@ def tool_measure_update(tool: LatheTool | Mapping[str, Any], quantity: str, meas
     wear += Δ, Δ = measured − effective, geometry unchanged. The caller has already applied the
     turning §0.11 checks (_TSA, _TDIF, _TZL). The cutting-edge position ``sl`` is never changed.
     """
-    _check_quantity(quantity)
+    checks.choice("quantity", quantity, QUANTITIES)
     before = tool_dict(tool)
     after = copy.deepcopy(before)
     base = 0.0 if quantity == "radius" else float(before["base"].get(quantity, 0.0))
@@ -194,7 +189,7 @@ def workpiece_tool_update(tool: LatheTool | Mapping[str, Any], quantity: str, c:
     _CHBIT[8]=0 as _CHBIT[6] with (geometry, wear) := (setup, sum); _CHBIT[8]=1: setup += c.
     A missing sum / setup record -> 61408 / 61409.
     """
-    _check_quantity(quantity)
+    checks.choice("quantity", quantity, QUANTITIES)
     before = tool_dict(tool)
     after = copy.deepcopy(before)
     c = float(c)

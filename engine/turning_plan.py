@@ -17,18 +17,17 @@ and call ``finish_lathe(prep, evaluation, decision=.., amount=.., ...)``.
 from __future__ import annotations
 
 import contextlib
-import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from functools import partial
-from typing import Any, Literal, overload
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from engine.alarms import AlarmDef
+from engine.checks import ParamError, param_bool, param_choice, param_int, param_number
 from engine.plan import run_program
-from engine.plan_base import ParamError
 from engine.turning import (
     AXIS_MA,
     LatheContext,
@@ -83,57 +82,6 @@ TASK_TOLERANCES = {
 
 # --- validation -------------------------------------------------------------------------------
 
-@overload
-def _number(params: Mapping[str, Any], name: str, default: object = None, *, required: Literal[True],
-            field_name: str | None = None) -> float: ...
-@overload
-def _number(params: Mapping[str, Any], name: str, default: object = None, *, required: bool = False,
-            field_name: str | None = None) -> float | None: ...
-def _number(params: Mapping[str, Any], name: str, default: object = None, *, required: bool = False,
-            field_name: str | None = None) -> float | None:
-    f = field_name or name
-    value = params.get(name, default)
-    if value is None or value == "":
-        if required:
-            raise ParamError(f, f"{f} is required")
-        return None
-    if isinstance(value, bool):
-        raise ParamError(f, f"{f} must be a number, got {value!r}")
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ParamError(f, f"{f} must be a number, got {value!r}") from None
-    if not math.isfinite(number):
-        raise ParamError(f, f"{f} must be a finite number, got {value!r}")
-    return number
-
-
-def _int(params: Mapping[str, Any], name: str, default: int, minimum: int, field_name: str | None = None) -> int:
-    f = field_name or name
-    value = _number(params, name, default, field_name=f)
-    if value is None or value != int(value) or value < minimum:
-        raise ParamError(f, f"{f} must be an integer >= {minimum}, got {params.get(name)!r}")
-    return int(value)
-
-
-def _bool(params: Mapping[str, Any], name: str, default: bool) -> bool:
-    value = params.get(name, default)
-    if not isinstance(value, bool):
-        raise ParamError(name, f"{name} must be true or false, got {value!r}")
-    return value
-
-
-def _choice(params: Mapping[str, Any], name: str, choices: tuple[str, ...], default: str | None, *,
-            required: bool = False) -> str:
-    value = params.get(name, default)
-    if value is None and required:
-        raise ParamError(name, f"{name} is required ({', '.join(map(str, choices))})")
-    if isinstance(value, str) and value.upper() in choices:
-        value = value.upper()
-    if value not in choices:
-        raise ParamError(name, f"{name} must be one of {', '.join(map(str, choices))}, got {params.get(name)!r}")
-    return str(value)
-
 
 def _tolerance(task: str, params: Mapping[str, Any]) -> dict[str, Any]:
     raw = params.get("tolerance", {}) or {}
@@ -150,13 +98,13 @@ def _tolerance(task: str, params: Mapping[str, Any]) -> dict[str, Any]:
                 raise ParamError(f, f"{f} must be true or false")
             out[k] = v
         elif k == "evnum":
-            out[k] = _int(raw, k, 0, 0, field_name=f)
+            out[k] = param_int(raw, k, 0, 0, field_name=f)
         elif k == "k":
-            out[k] = _number(raw, k, field_name=f)
+            out[k] = param_number(raw, k, field_name=f)
             if out[k] == 0:
                 raise ParamError(f, f"{f} (the weighting factor) must not be 0")
         else:
-            out[k] = _number(raw, k, field_name=f)
+            out[k] = param_number(raw, k, field_name=f)
             if k in ("zero_range", "mean_range", "dim_difference", "safe_area") and out[k] is not None and out[k] < 0:
                 raise ParamError(f, f"{f} must be >= 0, got {v!r}")
     return out
@@ -169,13 +117,13 @@ def _groove(params: Mapping[str, Any]) -> dict[str, Any]:
     if "number" in g:
         if len(g) != 1:
             raise ParamError("groove", "groove gives either a stored record number or the values")
-        return {"number": _int(g, "number", 1, 1, field_name="groove.number")}
+        return {"number": param_int(g, "number", 1, 1, field_name="groove.number")}
     keys = ("x_minus", "x_plus", "bottom_z", "z_minus", "z_plus", "top_x", "bottom_x")
     out: dict[str, Any] = {}
     for k in g:
         if k not in keys:
             raise ParamError(f"groove.{k}", f"groove.{k} is not a groove value ({', '.join(keys)})")
-        out[k] = _number(g, k, required=True, field_name=f"groove.{k}")
+        out[k] = param_number(g, k, required=True, field_name=f"groove.{k}")
     return out
 
 
@@ -195,8 +143,8 @@ def _target(params: Mapping[str, Any], zero_offsets: bool) -> str | dict[str, An
         return t.upper()
     if not isinstance(t, Mapping):
         raise ParamError("target", "target must be a zero offset name or a tool object")
-    tool = _int(t, "tool", 0, 1, field_name="target.tool")
-    edge = _int(t, "edge", 1, 1, field_name="target.edge")
+    tool = param_int(t, "tool", 0, 1, field_name="target.tool")
+    edge = param_int(t, "edge", 1, 1, field_name="target.edge")
     correct = str(t.get("correct", "length")).lower()
     if correct not in ("length", "radius", "l1", "l2", "l3"):
         raise ParamError("target.correct", f"target.correct must be length, radius, L1, L2 or L3, got {correct!r}")
@@ -224,13 +172,13 @@ def validate_lathe_params(task: str, params: Mapping[str, Any] | None) -> dict[s
     if rules is None:
         raise ParamError("task", f"unknown lathe task {task!r}")
     p = dict(params or {})
-    out: dict[str, Any] = {"probe": _int(p, "probe", 1, 1), "measurements": _int(p, "measurements", 1, 1),
+    out: dict[str, Any] = {"probe": param_int(p, "probe", 1, 1), "measurements": param_int(p, "measurements", 1, 1),
                            "tolerance": _tolerance(task, p)}
-    fa = _number(p, "measuring_path", 2.0, required=True)     # null/"": refused, not a TypeError
+    fa = param_number(p, "measuring_path", 2.0, required=True)     # null/"": refused, not a TypeError
     if fa <= 0.0:
         raise ParamError("measuring_path", f"measuring_path must be > 0, got {fa:g}")
     out["measuring_path"] = fa
-    feed = _number(p, "feed", 0.0, required=True)
+    feed = param_number(p, "feed", 0.0, required=True)
     if feed < 0.0:
         raise ParamError("feed", f"feed must be >= 0 (0 = the cycle's default), got {feed:g}")
     out["feed"] = feed
@@ -240,20 +188,20 @@ def validate_lathe_params(task: str, params: Mapping[str, Any] | None) -> dict[s
 
 def _tool_params(p: Mapping[str, Any], out: dict[str, Any], *, calibrate: bool = False, auto: bool = False) -> None:
     """CYCLE982: the tool probe's calibration (``calibrate``), a tool measured, or automatically (``auto``)."""
-    out["reference"] = _choice(p, "reference", ("machine", "workpiece"), "machine")
+    out["reference"] = param_choice(p, "reference", ("machine", "workpiece"), "machine")
     if not auto:
-        out["axis"] = _choice(p, "axis", ("Z", "X"), None, required=True)
-        out["incremental"] = _bool(p, "incremental", False)
+        out["axis"] = param_choice(p, "axis", ("Z", "X"), None, required=True)
+        out["incremental"] = param_bool(p, "incremental", False)
         if out["incremental"]:
-            out["direction"] = _choice(p, "direction", ("+", "-"), None, required=True)
+            out["direction"] = param_choice(p, "direction", ("+", "-"), None, required=True)
     if calibrate:
         return
-    out["compensation"] = _choice(p, "compensation", ("geometry", "wear"), "geometry")
-    out["quantity"] = _choice(p, "quantity", ("length", "radius", "length_radius"), "length")
-    out["reversal"] = _bool(p, "reversal", False)
-    out["position"] = _choice(p, "position", ("axial", "radial"), "axial")
-    out["start_angle"] = _number(p, "start_angle", 0.0, required=True)
-    out["correction_angle"] = _number(p, "correction_angle", 0.0, required=True)
+    out["compensation"] = param_choice(p, "compensation", ("geometry", "wear"), "geometry")
+    out["quantity"] = param_choice(p, "quantity", ("length", "radius", "length_radius"), "length")
+    out["reversal"] = param_bool(p, "reversal", False)
+    out["position"] = param_choice(p, "position", ("axial", "radial"), "axial")
+    out["start_angle"] = param_number(p, "start_angle", 0.0, required=True)
+    out["correction_angle"] = param_number(p, "correction_angle", 0.0, required=True)
     if auto and out["quantity"] != "length":
         raise ParamError("quantity", "lathe.tool.auto determines every quantity itself")
     if out.get("incremental") and out["quantity"] == "length_radius":
@@ -263,10 +211,10 @@ def _tool_params(p: Mapping[str, Any], out: dict[str, Any], *, calibrate: bool =
 def _groove_params(p: Mapping[str, Any], out: dict[str, Any]) -> None:
     """CYCLE973 in a reference groove."""
     out["groove"] = _groove(p)
-    out["axis"] = _choice(p, "axis", ("Z", "X"), None, required=True)
-    out["direction"] = _choice(p, "direction", ("+", "-", "both"), None, required=True)
-    out["skew"] = _bool(p, "skew", False)
-    out["ball_diameter"] = _bool(p, "ball_diameter", False)
+    out["axis"] = param_choice(p, "axis", ("Z", "X"), None, required=True)
+    out["direction"] = param_choice(p, "direction", ("+", "-", "both"), None, required=True)
+    out["skew"] = param_bool(p, "skew", False)
+    out["ball_diameter"] = param_bool(p, "ball_diameter", False)
     if out["direction"] != "both" and (out["skew"] or out["ball_diameter"]):
         name = "skew" if out["skew"] else "ball_diameter"
         raise ParamError(name, f"{name} needs direction \"both\": in one direction it cannot be determined "
@@ -275,15 +223,15 @@ def _groove_params(p: Mapping[str, Any], out: dict[str, Any]) -> None:
 
 def _surface_params(p: Mapping[str, Any], out: dict[str, Any]) -> None:
     """CYCLE973 on a surface."""
-    out["axis"] = _choice(p, "axis", ("Z", "X", "Y"), None, required=True)
-    out["direction"] = _choice(p, "direction", ("+", "-"), None, required=True)
-    out["setpoint"] = _number(p, "setpoint", required=True)
+    out["axis"] = param_choice(p, "axis", ("Z", "X", "Y"), None, required=True)
+    out["direction"] = param_choice(p, "direction", ("+", "-"), None, required=True)
+    out["setpoint"] = param_number(p, "setpoint", required=True)
 
 
 def _workpiece_params(p: Mapping[str, Any], out: dict[str, Any], *, zero_offsets: bool) -> None:
     """CYCLE974/994: axis, setpoint (the nominal; a different tolerance.setpoint is refused), target."""
-    out["axis"] = _choice(p, "axis", ("Z", "X", "Y"), None, required=True)
-    out["setpoint"] = _number(p, "setpoint", required=True)
+    out["axis"] = param_choice(p, "axis", ("Z", "X", "Y"), None, required=True)
+    out["setpoint"] = param_number(p, "setpoint", required=True)
     tol_set = out["tolerance"].get("setpoint")
     if tol_set is not None and tol_set != out["setpoint"]:
         raise ParamError("tolerance.setpoint", "tolerance.setpoint is not used: the task's setpoint is the "
@@ -294,8 +242,8 @@ def _workpiece_params(p: Mapping[str, Any], out: dict[str, Any], *, zero_offsets
 def _point_params(p: Mapping[str, Any], out: dict[str, Any]) -> None:
     """CYCLE974: one point; a zero offset or a tool as target, the reversal measurement."""
     _workpiece_params(p, out, zero_offsets=True)
-    out["reversal"] = _bool(p, "reversal", False)
-    angle = _number(p, "start_angle", 0.0, required=True)
+    out["reversal"] = param_bool(p, "reversal", False)
+    angle = param_number(p, "start_angle", 0.0, required=True)
     if not 0.0 <= angle <= 360.0:
         raise ParamError("start_angle", f"start_angle must be 0..360 deg, got {angle:g}")
     out["start_angle"] = angle
@@ -308,8 +256,8 @@ def _two_point_params(p: Mapping[str, Any], out: dict[str, Any]) -> None:
     _workpiece_params(p, out, zero_offsets=False)
     if out["setpoint"] <= 0.0:
         raise ParamError("setpoint", f"setpoint (the diameter) must be > 0, got {out['setpoint']:g}")
-    out["inside"] = _bool(p, "inside", False)
-    out["use_ball_diameter"] = _bool(p, "use_ball_diameter", False)
+    out["inside"] = param_bool(p, "inside", False)
+    out["use_ball_diameter"] = param_bool(p, "use_ball_diameter", False)
     zone = _zone(p.get("zone"))
     if not out["inside"] and (zone is None or "Z" not in zone or "X" not in zone):
         raise ParamError("zone", "an outside diameter needs the protection zone {\"Z\", \"X\"} for its detour")
@@ -324,7 +272,7 @@ def _zone(zone: Any) -> dict[str, float | None] | None:
     if not isinstance(zone, Mapping):
         raise ParamError("zone", "zone must be an object {\"Z\": _SZA, \"X\": _SZO}")
     extra = [k for k in zone if k not in ("Z", "X")]
-    z = {k: _number(zone, k, field_name=f"zone.{k}") for k in ("Z", "X") if k in zone}
+    z = {k: param_number(zone, k, field_name=f"zone.{k}") for k in ("Z", "X") if k in zone}
     if extra:
         raise ParamError(f"zone.{extra[0]}", "zone has the keys Z and X only")
     return z

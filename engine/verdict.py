@@ -28,6 +28,8 @@ import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
+from engine import checks
+
 __all__ = ["EPS", "MATERIAL_SIDES", "VERDICTS", "VERDICT_RULES", "SeriesStatistics", "series_statistics",
            "verdict", "worst"]
 
@@ -40,16 +42,12 @@ MATERIAL_SIDES = {"outer": 1, "inner": -1}
 D2_MOVING_RANGE = 1.128           # d2 for subgroups of 2 (moving range of individuals)
 
 
-def _finite(value: float | None) -> bool:
-    return value is not None and math.isfinite(value)
-
-
 def verdict(actual: float | None, lower: float | None, upper: float | None, material: int | None,
             rule: str = "material") -> str:
     """The verdict of one characteristic (module doc). ``material``: +1 outer, −1 inner, None."""
     if rule not in VERDICT_RULES:
         raise ValueError(f"verdict rule: one of {', '.join(VERDICT_RULES)}")
-    if not (_finite(actual) and _finite(lower) and _finite(upper)):
+    if not (checks.is_finite(actual) and checks.is_finite(lower) and checks.is_finite(upper)):
         return "not_decidable"
     assert actual is not None and lower is not None and upper is not None
     if lower - EPS <= actual <= upper + EPS:
@@ -83,7 +81,7 @@ class SeriesStatistics:
 
 def _capability(sigma: float | None, mean: float, lower: float | None, upper: float | None
                 ) -> tuple[float | None, float | None]:
-    if sigma is None or sigma <= 0.0 or not (_finite(lower) and _finite(upper)):
+    if sigma is None or sigma <= 0.0 or not (checks.is_finite(lower) and checks.is_finite(upper)):
         return None, None
     assert lower is not None and upper is not None
     return (upper - lower) / (6.0 * sigma), min(upper - mean, mean - lower) / (3.0 * sigma)
@@ -93,7 +91,7 @@ def series_statistics(values: Sequence[float], lower: float | None = None, upper
                       ) -> SeriesStatistics:
     """Individuals-chart statistics of a series in measuring order (module doc). Needs 2 values
     for σ, limits and capability; with fewer those are None."""
-    xs = [float(v) for v in values if _finite(v)]
+    xs = [float(v) for v in values if checks.is_finite(v)]
     n = len(xs)
     if n == 0:
         return SeriesStatistics(0, None, None, None, None, None, None, None, None, None)

@@ -22,9 +22,9 @@ import numpy as np
 from app.workflow import forms
 from app.workflow.context import MeasuringContext
 from engine import alarms
+from engine.checks import ParamError
 from engine.compensation import effective_radius
 from engine.kinematics import HEAD, TABLE, check_sphere_diameter, fit_axis, line_deviation, sphere_at_position
-from engine.plan_base import ParamError
 from engine.plan_kinematics import SphereProgram, sphere_position_program
 from engine.planes import Plane
 from engine.tasks import EngineTask, Family

@@ -26,8 +26,9 @@ from app.workflow import (
     planning,
 )
 from app.workflow.context import Finisher
+from engine.checks import ParamError
 from engine.coords import LatheToolTip
-from engine.plan_base import ParamError, PlanContext
+from engine.plan_base import PlanContext
 from engine.planes import Plane
 from engine.tasks import ENGINE_TASKS, EngineTask, Family
 from engine.turning_plan import LATHE_TASKS, lathe_program, prepare, validate_lathe_params

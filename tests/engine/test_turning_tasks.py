@@ -8,7 +8,7 @@ from test_turning_model import ProbeWorld, Solid, ToolWorld, TurningToolTruth, d
 from test_turning_probe import sl7_groove
 
 from engine import alarms
-from engine.plan_base import ParamError
+from engine.checks import ParamError
 from engine.turning import LatheContext, LatheProbe, LatheTool
 from engine.turning_plan import (
     LATHE_TASKS,
