@@ -18,7 +18,7 @@ from alembic import command
 from alembic.config import Config
 from alembic.runtime.migration import MigrationContext
 from alembic.script import ScriptDirectory
-from sqlalchemy import URL, Connection, Engine, create_engine, event, make_url, select, update
+from sqlalchemy import URL, Connection, Engine, bindparam, create_engine, event, make_url, select, update
 from sqlalchemy.exc import DBAPIError, OperationalError
 from sqlalchemy.orm import Session
 from sqlalchemy.pool import ConnectionPoolEntry
@@ -224,8 +224,7 @@ class Database:
                                      f"did not end within {BUSY_TIMEOUT_MS // 1000} s")
         try:
             with Session(self._write_engine, expire_on_commit=False) as session, session.begin():
-                session.execute(update(Machine).where(Machine.name == self.machine)
-                                .values(writes=Machine.writes + 1, last_seen=utc_now()))
+                session.connection().execute(_COUNT_WRITE, {"machine": self.machine, "now": utc_now()})
                 unit = Unit(session, self._layout, self.machine)
                 try:
                     yield unit
@@ -315,6 +314,10 @@ def _cause(exc: Exception) -> str:
 _PATH = re.compile(r"(?:[A-Za-z]:)?(?:[\\/][^\s\\/:\"']+){2,}[\\/]?")
 
 
+# a writing unit raises the write count (prepared once: Core, no ORM synchronisation)
+_MACHINES = Machine.__table__
+_COUNT_WRITE = (update(_MACHINES).where(_MACHINES.c.name == bindparam("machine"))
+                .values(writes=_MACHINES.c.writes + 1, last_seen=bindparam("now")))
 _WRITE_COUNT_SQL = (f"SELECT {Machine.__table__.c.writes.name} FROM {Machine.__tablename__} "
                    f"WHERE {Machine.__table__.c.name.name} = ?")
 

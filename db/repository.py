@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from datetime import UTC, datetime
 from typing import Any, TypeVar
 
-from sqlalchemy import Row, delete, exists, func, select
+from sqlalchemy import Row, bindparam, delete, exists, func, insert, select
 from sqlalchemy.orm import Session
 
 from db.models import (
@@ -210,12 +210,16 @@ class Unit(PartsUnit, PlantUnit, ProbeEventsUnit):
                   detail: dict[str, Any] | None = None) -> int:
         """One audit row naming the acting identity (``current_actor()``, else "system")."""
         actor = current_actor() or SYSTEM
-        row = OffsetAudit(machine=self.machine, time=_utc_now(), kind=kind, offset=str(name), before=_json_ready(before, "before"),
-                          after=_json_ready(after, "after"), source=str(source),
-                          detail=_json_ready(detail, "detail"), who=actor.who[:80], who_level=actor.level)
-        self._session.add(row)
+        return self._insert(_AUDIT_INSERT, {
+            "machine": self.machine, "time": _utc_now(), "kind": kind, "offset": str(name),
+            "before": _json_ready(before, "before"), "after": _json_ready(after, "after"), "source": str(source),
+            "detail": _json_ready(detail, "detail"), "who": actor.who[:80], "who_level": actor.level})
+
+    def _insert(self, statement, values: dict[str, Any]) -> int:
+        """One row by a prepared INSERT (no unit-of-work bookkeeping for a row nobody changes
+        afterwards in the transaction); what the session holds is written before it, in order."""
         self._session.flush()
-        return row.id
+        return int(self._session.connection().execute(statement, values).inserted_primary_key[0])
 
     def audit(self, limit: int = 200, name: str | None = None, kind: str | None = None,
               before_id: int | None = None) -> list[dict[str, Any]]:
@@ -235,10 +239,7 @@ class Unit(PartsUnit, PlantUnit, ProbeEventsUnit):
         return None if row is None or row.machine != self.machine else _audit_dict(row)
 
     def _frame_rows(self, name: str) -> dict[str, FrameAxis]:
-        rows = self._session.scalars(
-            select(FrameAxis).where(FrameAxis.machine == self.machine, FrameAxis.channel == CHANNEL,
-                                    FrameAxis.name == name)
-        )
+        rows = self._session.scalars(_FRAME_ROWS, {"machine": self.machine, "name": name})
         return {row.axis: row for row in rows}
 
     # --- tools ---------------------------------------------------------------------------
@@ -456,10 +457,8 @@ class Unit(PartsUnit, PlantUnit, ProbeEventsUnit):
         _check_keys(entry, LOG_FIELDS, "log entry")
         if not isinstance(entry.get("task"), str):
             raise ValueError("log entry needs a task name")
-        row = MeasurementLog(machine=self.machine, time=_utc_now(), **{key: _json_ready(entry.get(key), key) for key in LOG_FIELDS})
-        self._session.add(row)
-        self._session.flush()
-        return row.id
+        return self._insert(_LOG_INSERT, {"machine": self.machine, "time": _utc_now(),
+                                          **{key: _json_ready(entry.get(key), key) for key in LOG_FIELDS}})
 
     def list_log(self, limit: int = 500, offset: int = 0, before_id: int | None = None,
                  fields: Iterable[str] | None = None) -> list[dict[str, Any]]:
@@ -585,6 +584,13 @@ class _EndedTransaction:
 
 
 # --- row <-> dict helpers -------------------------------------------------------------------
+
+# prepared once (building a statement costs more than running it): the rows a measurement writes
+_FRAME_ROWS = select(FrameAxis).where(FrameAxis.machine == bindparam("machine"), FrameAxis.channel == CHANNEL,
+                                      FrameAxis.name == bindparam("name"))
+_AUDIT_INSERT = insert(OffsetAudit.__table__)
+_LOG_INSERT = insert(MeasurementLog.__table__)
+
 
 def _new_frame_axis(slot: OffsetSlot, axis: str, machine: str) -> FrameAxis:
     return FrameAxis(
