@@ -1,4 +1,5 @@
-"""Parser: program text -> ``nodes.Program`` (lark LALR on ``grammar.lark``).
+"""Parser: program text -> ``nodes.Program`` (``fastparse`` for correct programs; lark LALR on
+``grammar.lark`` for the rest, which words every syntax error).
 
 ``parse_program`` raises ``NcSyntaxError(line, column, message)`` in operator words for anything
 wrong with the text itself: the grammar, words that do not exist, words that may not stand
@@ -10,22 +11,26 @@ cycles are checked later against the variable store and the cycle registry
 
 from __future__ import annotations
 
+import gc
 import re
+import threading
 from bisect import bisect_left, bisect_right
 from collections.abc import Callable
+from contextlib import contextmanager
 from functools import lru_cache
 from importlib import resources
 from typing import Any
 
-from lark import Lark, Token, Transformer, Tree
+from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
 
 from engine import alarms
 
 from . import nodes as n
+from .build import ToNodes, lc, pos_of
 from .errors import NcSyntaxError
+from .fastparse import read_blocks
 from .modal import (
-    AXIS_LETTERS,
     FRAME_SUPPRESS,
     KNOWN_M,
     MEASURING,
@@ -44,16 +49,6 @@ _TERMINAL_WORDS = {
 }
 _EXPRESSION_START = {"NUMBER", "INT_NUMBER", "NAME", "RPARAM", "STRING", "LPAR", "ADD_OP", "NOT", "CONCAT",
                      "TRUE", "FALSE"}
-_UNSUPPORTED_ADDRESS = {
-    "I": "circle and helix parameters (I, J, K) are not part of this control's language",
-    "J": "circle and helix parameters (I, J, K) are not part of this control's language",
-    "K": "circle and helix parameters (I, J, K) are not part of this control's language",
-    "H": "auxiliary functions H are not part of this control's language",
-    "E": "exponent notation and E words are not part of this control's language",
-}
-_STRUCTURED = {"ELSE", "ENDIF", "WHILE", "ENDWHILE", "FOR", "ENDFOR", "LOOP", "ENDLOOP", "REPEAT",
-               "UNTIL", "CASE", "RET", "PROC"}
-TYPES = {"REAL", "INT", "BOOL", "STRING"}
 
 
 def _grammar() -> str:
@@ -63,9 +58,9 @@ def _grammar() -> str:
 @lru_cache(maxsize=1)
 def _lark() -> Lark:
     """The parser that builds the nodes while it parses (no parse tree: ~3x faster on long
-    programs, bench/bench_nc_parse.py); ``_ToNodes`` keeps no state, so one instance serves
+    programs, bench/bench_nc_parse.py); ``build.ToNodes`` keeps no state, so one instance serves
     every thread."""
-    return Lark(_grammar(), parser="lalr", lexer="contextual", transformer=_ToNodes(),
+    return Lark(_grammar(), parser="lalr", lexer="contextual", transformer=ToNodes(),
                 maybe_placeholders=True, start="start")
 
 
@@ -75,251 +70,6 @@ def _lark_tree() -> Lark:
     tokens before the error are on its stack)."""
     return Lark(_grammar(), parser="lalr", lexer="contextual", propagate_positions=True,
                 maybe_placeholders=True, start="start")
-
-
-def _pos(item) -> n.Pos:
-    if isinstance(item, Token):
-        assert item.line is not None and item.column is not None    # the lexer's tokens carry them
-        return n.Pos(item.line, item.column)
-    return n.Pos(item.meta.line, item.meta.column)
-
-
-def _number(text: str) -> int | float:
-    text = text.strip()
-    if "." in text:
-        return float(text)
-    return int(text)
-
-
-class _ToNodes(Transformer):
-    """The rules' callbacks -> nodes, called by the parser as it reduces. Raises NcSyntaxError
-    for invalid words. No state: the parser and this instance are shared between threads."""
-
-    # --- program and blocks -------------------------------------------------------------------
-    def start(self, items):
-        return list(items)
-
-    def header_block(self, items):
-        return ("HEADER", items[0])
-
-    def block(self, items):
-        return ("BLOCK", items)
-
-    # --- expressions ------------------------------------------------------------------------
-    def number(self, items):
-        (tok,) = items
-        return n.Num(_number(tok.value), _pos(tok))
-
-    def string(self, items):
-        (tok,) = items
-        return n.Str(tok.value[1:-1], _pos(tok))
-
-    def true(self, items):
-        return n.Num(1, _pos(items[0]))
-
-    def false(self, items):
-        return n.Num(0, _pos(items[0]))
-
-    def rparam(self, items):
-        (tok,) = items
-        return n.Var("R", (n.Num(int(tok.value[1:]), n.Pos(tok.line, tok.column + 1)),), _pos(tok))
-
-    def name(self, items):
-        (tok,) = items
-        return n.Var(tok.value.upper(), (), _pos(tok))
-
-    def indexed(self, items):
-        tok, exprs = items
-        return n.Var(tok.value.upper(), tuple(exprs), _pos(tok))
-
-    def function(self, items):
-        tok, exprs = items
-        return n.Func(tok.value.upper(), tuple(exprs or ()), _pos(tok))
-
-    def exprs(self, items):
-        return list(items)
-
-    def chain(self, items):
-        return _climb(items)
-
-    def unop(self, items):
-        op, operand = items
-        return n.Unary(op.value.upper(), operand, _pos(op))
-
-    def set_list(self, items):
-        _set, exprs = items
-        return ("SET", tuple(exprs), _pos(_set))
-
-    # --- words --------------------------------------------------------------------------------
-    def address(self, items):
-        (tok,) = items
-        return _address_word(tok)
-
-    def assignment(self, items):
-        target, value = items
-        pos = target.pos
-        values, is_set = ((value[1], True) if isinstance(value, tuple) else ((value,), False))
-        name = target.name
-        if not target.indices and name in _ASSIGN_WORDS:
-            if is_set:
-                raise NcSyntaxError(f"{name}=SET(...) is not allowed; SET fills arrays", *_lc(pos))
-            return _ASSIGN_WORDS[name](name, values[0], pos)
-        if not target.indices and name in _EXAMPLES:
-            raise NcSyntaxError(f"{name}= is not allowed: write {name} with its number, e.g. {_EXAMPLES[name]}",
-                                *_lc(pos))
-        return n.Assign(target, values, pos, is_set)
-
-    def bare_name(self, items):
-        (tok,) = items
-        name = tok.value.upper()
-        pos = _pos(tok)
-        if name in AXIS_LETTERS or name in ("F", "S", "T", "D", "SPOS", "MEAS", "MEAW"):
-            raise NcSyntaxError(f"{name} needs a value (e.g. {name}10 or {name}=R1)"
-                                if len(name) == 1 else f"{name} needs a value: {name}=...", *_lc(pos))
-        if name == "SUPA":
-            # SUPA suppresses the frames like G53 and also handwheel offsets, external zero offsets
-            # and PRESET (840D Fundamentals, "Frame suppression"): this control has none of those,
-            # so SUPA is G53 here (manual listings §6: N30 SUPA G0 Z100)
-            return n.GCode(53, pos)
-        if name in _STRUCTURED:
-            raise NcSyntaxError(f"{name}: structured control statements are not part of this control's "
-                                f"language (use IF ... GOTOF/GOTOB with labels)", *_lc(pos))
-        return n.CycleCall(name, (), pos)
-
-    def call(self, items):
-        tok, exprs = items
-        return n.CycleCall(tok.value.upper(), tuple(exprs or ()), _pos(tok))
-
-    def goto(self, items):
-        kw, target = items
-        value = target.value.upper()
-        if target.type == "BLOCKNO":
-            value = f"N{int(value[1:])}"
-        return n.Goto(kw.value.upper(), value, _pos(kw))
-
-    def msg(self, items):
-        kw, expr = items
-        return n.Msg(expr, _pos(kw))
-
-    def stopre(self, items):
-        return n.Stopre(_pos(items[0]))
-
-    def words(self, items):
-        return list(items)
-
-    def if_goto(self, items):
-        kw, cond, goto = items
-        return [n.IfGoto(cond, goto, _pos(kw))]
-
-    def type_length(self, items):
-        return int(items[0].value)
-
-    def dims(self, items):
-        return tuple(int(t.value) for t in items)
-
-    def def_item(self, items):
-        tok, dims, init = items
-        name = tok.value.upper()
-        pos = _pos(tok)
-        _check_user_name(name, pos)
-        if dims is not None and any(d < 1 for d in dims):
-            raise NcSyntaxError(f"DEF {name}: an array needs at least 1 element", *_lc(pos))
-        return n.DefItem(name, dims or (), init, pos)
-
-    def definition(self, items):
-        kw, type_tok, length, *defs = items
-        type_name = type_tok.value.upper()
-        if type_name not in TYPES:
-            raise NcSyntaxError(f"DEF {type_tok.value}: the type must be REAL, INT, BOOL or STRING[n]",
-                                *_lc(_pos(type_tok)))
-        if length is not None and type_name != "STRING":
-            raise NcSyntaxError(f"DEF {type_name}[{length}]: only STRING takes a length", *_lc(_pos(type_tok)))
-        return [n.Define(type_name, length, tuple(defs), _pos(kw))]
-
-    def label(self, items):
-        tok = items[0]
-        _check_user_name(tok.value.upper(), _pos(tok))
-        return ("LABEL", tok)
-
-
-#: how strongly an operator binds (840D: comparisons weakest, then << (text concatenation), OR,
-#: XOR, AND, + -, * / DIV MOD)
-_PRIORITY = {"CMP_OP": 1, "CONCAT": 1.5, "OR": 2, "XOR": 3, "AND": 4, "ADD_OP": 5, "MUL_OP": 6, "DIV": 6,
-             "MOD": 6}
-
-
-def _climb(items: list) -> n.Expr:
-    """``operand (operator operand)*`` -> the tree of binary operations: left-associative, by
-    ``_PRIORITY``; one comparison per chain (``a < b < c`` means nothing on the 840D)."""
-    operands: list[n.Expr] = [items[0]]
-    operators: list[Token] = []
-    comparison: Token | None = None
-
-    def reduce() -> None:
-        op = operators.pop()
-        right = operands.pop()
-        operands.append(n.Binary(op.value.upper(), operands.pop(), right, _pos(op)))
-
-    for k in range(1, len(items), 2):
-        op = items[k]
-        if op.type == "CMP_OP":
-            if comparison is not None:
-                raise NcSyntaxError(f"a second comparison {op.value} after {comparison.value}: compare two values "
-                                    "once and combine conditions with AND / OR", *_lc(_pos(op)))
-            comparison = op
-        while operators and _PRIORITY[operators[-1].type] >= _PRIORITY[op.type]:
-            reduce()
-        operators.append(op)
-        operands.append(items[k + 1])
-    while operators:
-        reduce()
-    return operands[0]
-
-
-def _lc(pos: n.Pos) -> tuple[int, int]:
-    return pos.line, pos.column
-
-
-def _check_user_name(name: str, pos: n.Pos) -> None:
-    if name in AXIS_LETTERS or name in ("F", "S", "T", "D", "G", "M", "N", "L", "R", "SPOS", "MEAS",
-                                        "MEAW") or name in TYPES:
-        raise NcSyntaxError(f"{name} is a word of the language and cannot be used as a name", *_lc(pos))
-
-
-def _address_word(tok: Token):
-    text = tok.value.upper()
-    letter, raw = text[0], text[1:]
-    pos = _pos(tok)
-    value = _number(raw)
-    if letter in ("G", "M", "L", "N"):
-        if not isinstance(value, int) or raw.startswith(("+", "-")):
-            raise NcSyntaxError(f"{tok.value}: {letter} takes a whole number", *_lc(pos))
-        if letter == "G":
-            return n.GCode(value, pos)
-        if letter == "M":
-            return n.MCode(value, pos)
-        if letter == "L":
-            return n.CycleCall(f"L{value}", (), pos)
-        raise NcSyntaxError(f"block number {tok.value} must stand at the start of the block", *_lc(pos))
-    num = n.Num(value, n.Pos(pos.line, pos.column + 1))
-    if letter in AXIS_LETTERS:
-        return n.AxisWord(letter, num, pos)
-    if letter in ("F", "S", "T", "D"):
-        return n.Address(letter, num, pos)
-    if letter == "R":
-        raise NcSyntaxError(f"{tok.value}: an R parameter has a number (R1) and is assigned with '='", *_lc(pos))
-    reason = _UNSUPPORTED_ADDRESS.get(letter, f"the address {letter} is not part of this control's language")
-    raise NcSyntaxError(f"{tok.value}: {reason}", *_lc(pos))
-
-
-_EXAMPLES = {"G": "G1", "M": "M30", "N": "N10", "L": "L977"}
-_ASSIGN_WORDS = {
-    **{a: (lambda name, value, pos: n.AxisWord(name, value, pos)) for a in AXIS_LETTERS},
-    **{a: (lambda name, value, pos: n.Address(name, value, pos)) for a in ("F", "S", "T", "D")},
-    "SPOS": lambda name, value, pos: n.Spos(value, pos),
-    "MEAS": lambda name, value, pos: n.Meas(name, value, pos),
-    "MEAW": lambda name, value, pos: n.Meas(name, value, pos),
-}
 
 
 # --- errors in operator words -------------------------------------------------------------------
@@ -426,8 +176,8 @@ def _scan_line(line: str, number: int) -> None:
         raise NcSyntaxError(f"the block has {len(line)} characters; a block holds at most {MAX_BLOCK_CHARS} "
                             "(split it into several blocks)", number, MAX_BLOCK_CHARS + 1,
                             block_text=line[:80])
-    if line.isascii() and "(" not in line and "[" not in line:
-        return
+    if line.isascii() and line.count("(") + line.count("[") <= MAX_NESTING:
+        return              # no other characters, and not so many parentheses that they could nest too deep
     if line.lstrip().startswith("%"):
         return              # the program name line (a file name, not a block: the manual prints %_N_斜面测量_MPF)
     depth = 0
@@ -481,15 +231,49 @@ def parse_program(text: str, name: str = "MDA") -> n.Program:
     lines = source.split("\n")
     for number, line in enumerate(lines, start=1):
         _scan_line(line, number)
+    with _collector_paused():
+        raw_blocks = read_blocks(lines)         # the fast reader; None: lark reads it and words the error
+        if raw_blocks is None:
+            raw_blocks = _lark_blocks(source, lines)
+        return _assemble(raw_blocks, source, lines, name)
+
+
+_collector_lock = threading.Lock()
+_collector_readers = 0
+_collector_was_on = False
+
+
+@contextmanager
+def _collector_paused():
+    """Python's cycle collector waits while programs are read: reading makes many small objects
+    and no cycles, and each collection walks the whole heap (a third of the time of a 200 KB
+    program, bench/bench_nc_parse.py). Counted, so readers in several threads share one pause."""
+    global _collector_readers, _collector_was_on
+    with _collector_lock:
+        if _collector_readers == 0:
+            _collector_was_on = gc.isenabled()
+            gc.disable()
+        _collector_readers += 1
     try:
-        raw_blocks = _lark().parse(source + "\n")
+        yield
+    finally:
+        with _collector_lock:
+            _collector_readers -= 1
+            if _collector_readers == 0 and _collector_was_on:
+                gc.enable()
+
+
+def _lark_blocks(source: str, lines: list[str]) -> list:
+    """lark's reading: the blocks as ``build.ToNodes`` gives them, or the error in operator words."""
+    try:
+        blocks: list = _lark().parse(source + "\n")      # type: ignore[assignment]  # the transformer gives a list
+        return blocks
     except UnexpectedInput as e:
         raise _worded(e, lines) from None
     except NcSyntaxError as err:
         if err.line is not None and err.block_text is None and 0 < err.line <= len(lines):
             err.block_text = lines[err.line - 1].strip()
         raise
-    return _assemble(raw_blocks, source, lines, name)
 
 
 def _worded(e: UnexpectedInput, lines: list[str]) -> NcSyntaxError:
@@ -509,8 +293,8 @@ def _block_start(items) -> tuple[int, int]:
     if isinstance(first, tuple):                # ("LABEL", token)
         first = first[1]
     if isinstance(first, Token):
-        return _lc(_pos(first))
-    return _lc(first[0].pos)                    # the words of the body
+        return lc(pos_of(first))
+    return lc(first[0].pos)                    # the words of the body
 
 
 def _assemble(raw_blocks, source: str, lines: list[str], name: str) -> n.Program:
@@ -603,16 +387,17 @@ def _check_m_functions(words: _Words) -> None:
             raise _err(same[1], f"M{same[1].number} and M{same[0].number} exclude each other in one block")
 
 
-#: the word a block may hold once, by its kind
-_ONCE: tuple[tuple[type | tuple[type, ...], Callable[[Any], str | None]], ...] = (
-    (n.AxisWord, lambda w: w.axis), (n.Address, lambda w: w.letter), (n.Spos, lambda w: "SPOS"),
-    (n.Meas, lambda w: "MEAS/MEAW"), ((n.Goto, n.IfGoto), lambda w: "GOTO"), (n.Msg, lambda w: "MSG"),
-    (n.MCode, lambda w: "M6" if w.number == 6 else None),
-)
+#: the word a block may hold once, by its kind (node classes have no subclasses)
+_ONCE: dict[type, Callable[[Any], str | None]] = {
+    n.AxisWord: lambda w: w.axis, n.Address: lambda w: w.letter, n.Spos: lambda w: "SPOS",
+    n.Meas: lambda w: "MEAS/MEAW", n.Goto: lambda w: "GOTO", n.IfGoto: lambda w: "GOTO", n.Msg: lambda w: "MSG",
+    n.MCode: lambda w: "M6" if w.number == 6 else None,
+}
 
 
 def _once_key(w) -> str | None:
-    return next((key(w) for kind, key in _ONCE if isinstance(w, kind)), None)
+    key = _ONCE.get(type(w))
+    return None if key is None else key(w)
 
 
 def _check_once(words: _Words) -> None:
@@ -687,16 +472,23 @@ def _check_meas(words: _Words) -> None:
         raise _err(motion, f"{meas.kind} is a measuring move at feed: program G1, not G0")
 
 
-#: the block checks, group by group, in the order the operator is told about them
-_BLOCK_CHECKS = (_check_g_groups, _check_m_functions, _check_once, _check_spos, _check_calls, _check_g101_g102,
-                 _check_g100, _check_meas)
+#: the block checks, group by group, in the order the operator is told about them; each with the
+#: kinds of word it looks at (a block with none of them passes it: no need to ask)
+_BLOCK_CHECKS: tuple[tuple[Callable[[_Words], None], frozenset[type]], ...] = (
+    (_check_g_groups, frozenset({n.GCode})), (_check_m_functions, frozenset({n.MCode})),
+    (_check_once, frozenset(_ONCE)), (_check_spos, frozenset({n.Spos})), (_check_calls, frozenset({n.CycleCall})),
+    (_check_g101_g102, frozenset({n.GCode})), (_check_g100, frozenset({n.GCode})),
+    (_check_meas, frozenset({n.Meas})),
+)
 
 
 def _check_block(block: n.Block) -> None:
     """Words that may not stand together in one block (independent of the configuration)."""
+    kinds = {type(w) for w in block.words}
     words = _Words(block)
-    for check in _BLOCK_CHECKS:
-        check(words)
+    for check, looks_at in _BLOCK_CHECKS:
+        if not kinds.isdisjoint(looks_at):
+            check(words)
 
 
 def _g100_extra_ok(word) -> bool:
