@@ -231,6 +231,30 @@
     }
   });
 
+  // --- a level that may not run this screen's task (data-start-denied on #screen, issue 29
+  // item 4): NC Start is disabled with the reason from the moment the screen opens, not refused
+  // after the press; the next screen that allows it enables it again
+  function showStartLock() {
+    var key = document.getElementById("nc-start");
+    if (!key) return;
+    var screen = document.getElementById("screen");
+    var reason = screen ? screen.getAttribute("data-start-denied") : null;
+    if (reason) {
+      key.disabled = true;
+      key.title = reason;
+      key.classList.add("denied");
+      key.dataset.levelLock = "1";
+    } else if (key.dataset.levelLock) {
+      key.disabled = false;
+      key.removeAttribute("title");
+      key.classList.remove("denied");
+      delete key.dataset.levelLock;
+    }
+  }
+  document.addEventListener("DOMContentLoaded", showStartLock);
+  document.addEventListener("htmx:afterSettle", showStartLock);
+  document.addEventListener("htmx:historyRestore", showStartLock);
+
   // --- NC Start: a measuring screen marks its start element with data-ncstart and
   // hx-trigger="ncstart"; without one NC Start has no function here (JOG basic screen).
   document.addEventListener("click", function (event) {

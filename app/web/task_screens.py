@@ -15,7 +15,7 @@ import numpy as np
 from fastapi import APIRouter, HTTPException, Request
 from starlette.concurrency import run_in_threadpool
 
-from app.access.deps import needs, require_measurement
+from app.access.deps import denied, measuring_function, needs, require_measurement
 from app.errors import WorkflowError
 from app.i18n import N_, _, language
 from app.services.measuring import MeasuringEnv
@@ -400,8 +400,23 @@ def _screen_context(env: _Env, page: TaskPage, form: dict | None, *, answer=None
         "decision_alarm": ((answer or {}).get("result") or {}).get("alarm"),
         "running": running,
         "progress": progress,
+        "start_denied": _start_denied(env, spec, data),
         **task_help.context(env.services, task, data.values),      # help picture, equipment (issue 17 item 5)
     }
+
+
+def _start_denied(env: _Env, spec, data) -> str:
+    """Why this level may not start the task with the chosen target ('' when it may): the checks
+    NC Start makes (``require_measurement``), asked when the screen opens, so that the lock shows
+    before it bites (issue 29 item 4)."""
+    reason = denied(env.request, "measure")
+    if reason:
+        return reason
+    target = data.params.get("target") if spec.lathe else data.target
+    if target is None and spec.corrects_zero_offset and not spec.lathe:
+        target = env.machine.active_offset
+    function = measuring_function(spec.category, target)
+    return denied(env.request, function) if function else ""
 
 
 def _decision(answer: dict | None) -> str | None:

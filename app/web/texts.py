@@ -342,6 +342,14 @@ message(r"Measurement done", N_("Measurement done"))
 message(r"Calculated: WO activated", N_("Calculated: WO activated"))
 message(r"Calculated", N_("Calculated"))
 
+# a function the level may not do (app/access/deps.denied: disabled keys, locked NC Start)
+message(r"needs level (?P<level>\d+): keyswitch position (?P<position>\d+) or higher, or a password",
+        N_("needs level %(level)s: keyswitch position %(position)s or higher, or a password"))
+message(r"needs level (?P<level>\d+): a password of level (?P<password>\d+) or higher",
+        N_("needs level %(level)s: a password of level %(password)s or higher"))
+message(r"needs level (?P<level>\d+): a password of level (?P<password>\d+)",
+        N_("needs level %(level)s: a password of level %(password)s"))
+
 # sign-in (app/access/service.py, app/access/throttle.py)
 message(r"wrong user name or password", N_("wrong user name or password"))
 message(r"too many failed sign-ins from this computer: try again in (?P<seconds>\d+) s",
