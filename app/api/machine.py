@@ -76,11 +76,12 @@ def health() -> dict:
 
 
 @router.get("/machine", name="api_machine", response_model=dict)
-async def machine_state(machine: MachineDep) -> Response:
+async def machine_state(request: Request) -> Response:
     # the snapshot's bytes, encoded once per state version (issue 30 item 2); on the event loop: a
     # snapshot waits for nothing (the machines' status locks are held for a read, the write count
-    # is a WAL read), and a worker-thread hop would cost more than the answer
-    return Response(machine.snapshot().json, media_type="application/json")
+    # is a WAL read), and a worker-thread hop would cost more than the answer; the service read
+    # directly (a dependency costs more than the answer too)
+    return Response(request.app.state.services.machine.snapshot().json, media_type="application/json")
 
 
 @router.post("/machine/jog", name="api_machine_jog", dependencies=[needs("jog")])

@@ -114,6 +114,7 @@ class MachineService:
         self._db = db
         self._rebuild = rebuild              # builds the machine of a scenario of the other kind
         self._machine = machine
+        self._capabilities: tuple[Machine | None, dict[type, bool]] = (None, {})
         self._scenario = scenario
         self._settings = settings
         self._lock = threading.RLock()       # guards chain/tool bookkeeping, not the motion itself
@@ -187,15 +188,27 @@ class MachineService:
         return self._chain
 
     # --- what the machine is (its capabilities, protocol.py; asked here once each) ----------------
+    def _is(self, protocol: type) -> bool:
+        """``isinstance(machine, protocol)``, asked once per machine object: a runtime-checkable
+        protocol's check looks up every member, and every poll's snapshot asks (issue 30 item 2)."""
+        machine = self._machine
+        known = self._capabilities
+        if known[0] is not machine:
+            known = self._capabilities = (machine, {})
+        answer = known[1].get(protocol)
+        if answer is None:
+            answer = known[1][protocol] = isinstance(machine, protocol)
+        return answer
+
     @property
     def is_lathe(self) -> bool:
         """The machine is a lathe (turning.md §10.2): X radius, DIAMON, the lathe tasks."""
-        return isinstance(self._machine, Lathe)
+        return self._is(Lathe)
 
     @property
     def diameter_programming(self) -> bool:
         machine = self._machine
-        return isinstance(machine, Lathe) and bool(machine.diameter_programming)
+        return self._is(Lathe) and bool(machine.diameter_programming)  # type: ignore[attr-defined]
 
     @property
     def spos_capable(self) -> bool:
@@ -352,7 +365,7 @@ class MachineService:
 
     # --- swivel head (CYCLE800-like re-alignment, jog-measuring §6.2) --------------------------------
     def _swivel_head(self) -> SwivelHead | None:
-        return self._machine if isinstance(self._machine, SwivelHead) else None
+        return self._machine if self._is(SwivelHead) else None  # type: ignore[return-value]
 
     def has_swivel(self) -> bool:
         head = self._swivel_head()

@@ -10,6 +10,7 @@ from dataclasses import replace
 from typing import Annotated
 
 from fastapi import APIRouter, Form, Request
+from fastapi.responses import HTMLResponse
 
 from app.access.deps import needs
 from app.deps import MachineDep
@@ -33,8 +34,26 @@ def header(request: Request):
 
 
 @router.get("/ui/position", name="panel_position")
-def position(request: Request):
-    return render_block(request, "base.html", "position_values")
+async def position(request: Request):
+    """The live position values, rendered once per state version and what else they show (the
+    tab's panel, the settings, the language): a poll at rest costs no template (issue 30 item 2).
+    On the event loop like ``GET /api/machine``: a hit waits for nothing, a worker-thread hop would
+    cost more than the answer."""
+    services = request.app.state.services
+    machine = services.machine
+    snapshot = machine.snapshot()
+    gud = services.settings.get()
+    key = (PanelState.of(request, machine.axes), getattr(request.state, "language", None),
+           request.scope.get("root_path", ""))
+    cache = getattr(request.app.state, "position_cache", None)
+    if cache is None or cache[0] is not snapshot or not (cache[1] is gud or cache[1] == gud) or len(cache[2]) > 64:
+        cache = (snapshot, gud, {})
+        request.app.state.position_cache = cache
+    body = cache[2].get(key)
+    if body is None:
+        body = render_block(request, "base.html", "position_values", {"status": snapshot.body, "gud": gud}).body
+        cache[2][key] = body
+    return HTMLResponse(body)
 
 
 def _panel(request: Request, machine, **chosen) -> PanelState:
