@@ -7,17 +7,19 @@ Validation models shared by the services (API/screen writes) and the measuring w
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Literal
+from typing import Any, Literal
 
 from pydantic import (
     BaseModel,
     ConfigDict,
     Field,
+    SerializerFunctionWrapHandler,
     StrictBool,
     StrictFloat,
     StrictInt,
     ValidationInfo,
     field_validator,
+    model_serializer,
 )
 
 from app import checks
@@ -63,7 +65,30 @@ def _check_trigger_keys(value: dict[str, float]) -> dict[str, float]:
     return value
 
 
-class ProbeData(BaseModel):
+class ProbeHealthFields(BaseModel):
+    """The health fields a workpiece probe record (_WP) and a tool probe record (_TP) share
+    (design.md §10.4): kept by the HMI (a PUT keeps the stored ones, app.services.probes);
+    ``valid``/``invalid_reason``/``calibration_age_h`` are worked out on each read and ignored
+    when sent. A record dumps them last, after its own fields, as it always stored them."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+    calibration_id: StrictInt | None = None        # the calibration's probe_events row
+    probe_identity: str | None = Field(None, max_length=40)    # the scenario probe that was calibrated
+    invalidated: dict | None = None                # {"reason", "at", "text"}: what made it invalid
+    repeatability: dict | None = None              # the last check {"n", "two_sigma", "range", "at", ...}
+    valid: StrictBool | None = None
+    invalid_reason: str | None = None
+    calibration_age_h: float | None = None
+
+    @model_serializer(mode="wrap")
+    def _health_last(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        data = handler(self)
+        health = [k for k in ProbeHealthFields.model_fields if k in data]
+        return {**{k: v for k, v in data.items() if k not in ProbeHealthFields.model_fields},
+                **{k: data[k] for k in health}}
+
+
+class ProbeData(ProbeHealthFields):
     """_WP[k]: mirrors ``engine.types.ProbeRecord`` (trigger = ball centre minus surface per direction)."""
 
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
@@ -95,15 +120,6 @@ class ProbeData(BaseModel):
     # pre-travel turns with the spindle ("probe") or stays with the machine axes ("machine")
     measured_ball_diameter: StrictFloat | None = Field(None, gt=0, le=100)
     pretravel_frame: Literal["probe", "machine"] | None = None
-    # probe health (design.md §10.4): kept by the HMI (a PUT keeps the stored ones, app.services.probes);
-    # ``valid``/``invalid_reason``/``calibration_age_h`` are worked out on each read and ignored when sent
-    calibration_id: StrictInt | None = None        # the calibration's probe_events row
-    probe_identity: str | None = Field(None, max_length=40)    # the scenario probe that was calibrated
-    invalidated: dict | None = None                # {"reason", "at", "text"}: what made it invalid
-    repeatability: dict | None = None              # the last check {"n", "two_sigma", "range", "at", ...}
-    valid: StrictBool | None = None
-    invalid_reason: str | None = None
-    calibration_age_h: float | None = None
 
     # A probe's own physics bounds its data (measuring-math §5.1, measuring-math §5.2): the ball centre switches
     # within one ball diameter of the surface, the stylus is off the spindle axis by at most
@@ -143,7 +159,7 @@ class ProbeData(BaseModel):
         return value
 
 
-class ToolProbeData(BaseModel):
+class ToolProbeData(ProbeHealthFields):
     """_TP[k]: trigger values in MCS of the tool edge at switching (jog-measuring §7.2)."""
 
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
@@ -161,15 +177,6 @@ class ToolProbeData(BaseModel):
     calibrated_at: str | None = Field(None, max_length=40)
     # the lathe's _TPW[k] (workpiece-related trigger values, SW 6.3, turning.md §0.7), keyed as trigger
     workpiece_trigger: dict[str, StrictFloat] | None = None
-    # probe health (design.md §10.4): kept by the HMI (a PUT keeps the stored ones, app.services.probes);
-    # ``valid``/``invalid_reason``/``calibration_age_h`` are worked out on each read and ignored when sent
-    calibration_id: StrictInt | None = None        # the calibration's probe_events row
-    probe_identity: str | None = Field(None, max_length=40)    # the scenario probe that was calibrated
-    invalidated: dict | None = None                # {"reason", "at", "text"}: what made it invalid
-    repeatability: dict | None = None              # the last check {"n", "two_sigma", "range", "at", ...}
-    valid: StrictBool | None = None
-    invalid_reason: str | None = None
-    calibration_age_h: float | None = None
 
     @field_validator("trigger")
     @classmethod

@@ -168,3 +168,10 @@ def param_choice(params: Mapping[str, Any], name: str, choices: tuple[str, ...],
     if value not in choices:
         raise ParamError(name, f"{name} must be one of {', '.join(map(str, choices))}, got {params.get(name)!r}")
     return str(value)
+
+
+def param_real(field: str, value: object) -> float:
+    """A value the client gave as a JSON number: finite, no text, no bool; ParamError naming ``field``."""
+    if not is_number(value) or not math.isfinite(float(value)):
+        raise ParamError(field, f"{field}: a finite number is needed, got {value!r}")
+    return float(value)

@@ -43,12 +43,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from engine import alarms
+from engine.checks import real
 
 from .checks import finite
 from .lathe_kinematics import LatheKinematics
 from .lathe_scenario import LatheScenario
 from .lathe_scene import LatheContact, lathe_outline, tool_outline
-from .nc_data import NcData, _number, _object
+from .nc_data import NcData, _object
 from .probe_signal import TOOL, WORKPIECE
 from .protocol import MachineBusy, MachineStatus
 from .simulated import SimulatedControl
@@ -74,10 +75,10 @@ class LatheNcData(NcData):
         if isinstance(sl, bool) or not isinstance(sl, int) or not 0 <= sl <= 9:
             raise ValueError(f"sl: a cutting edge position 0..9, got {sl!r}")
         wear = _object(data.get("wear") or {}, "wear", LATHE_WEAR_KEYS)
-        self._tools[t] = {"type": tool_type, "sl": sl, "length": _number(data.get("length", 0.0), "length"),
-                          "radius": _number(data["radius"], "radius"),
-                          "l1": _number(data.get("l1", 0.0), "l1"), "l2": _number(data.get("l2", 0.0), "l2"),
-                          "wear": {k: _number(wear.get(k, 0.0), f"wear.{k}") for k in LATHE_WEAR_KEYS}}
+        self._tools[t] = {"type": tool_type, "sl": sl, "length": real("length", data.get("length", 0.0)),
+                          "radius": real("radius", data["radius"]),
+                          "l1": real("l1", data.get("l1", 0.0)), "l2": real("l2", data.get("l2", 0.0)),
+                          "wear": {k: real(f"wear.{k}", wear.get(k, 0.0)) for k in LATHE_WEAR_KEYS}}
 
     def lengths(self, t: int | None) -> tuple[float, float]:
         """The effective (L1, L2) the NC uses for T ``t`` (geometry + wear); 0 when unknown."""

@@ -9,19 +9,14 @@ checked like a control's data interface would: a ValueError names the bad field.
 from __future__ import annotations
 
 import copy
-import math
+
+from engine.checks import real
 
 from .scenario import GEOMETRY_AXES
 
 FRAME_PARTS = ("trans", "fine", "rot")
 TOOL_KEYS = ("type", "length", "radius", "wear")
 WEAR_KEYS = ("length", "radius")
-
-
-def _number(value, field: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise ValueError(f"{field}: must be a finite number, got {value!r}")
-    return float(value)
 
 
 def _object(value, field: str, allowed) -> dict:
@@ -59,7 +54,7 @@ class NcData:
         checked = {}
         for part in FRAME_PARTS:
             values = _object(frame.get(part) or {}, part, allowed[part])
-            checked[part] = {axis: _number(v, f"{part}.{axis}") for axis, v in values.items()}
+            checked[part] = {axis: real(f"{part}.{axis}", v) for axis, v in values.items()}
         self._offsets[name] = checked
 
     def write_tool(self, t: int, data: dict) -> None:
@@ -73,6 +68,6 @@ class NcData:
         if isinstance(tool_type, bool) or not isinstance(tool_type, int):
             raise ValueError(f"type: must be an integer tool type, got {tool_type!r}")
         wear = _object(data.get("wear") or {}, "wear", WEAR_KEYS)
-        self._tools[t] = {"type": tool_type, "length": _number(data["length"], "length"),
-                          "radius": _number(data["radius"], "radius"),
-                          "wear": {k: _number(wear.get(k, 0.0), f"wear.{k}") for k in WEAR_KEYS}}
+        self._tools[t] = {"type": tool_type, "length": real("length", data["length"]),
+                          "radius": real("radius", data["radius"]),
+                          "wear": {k: real(f"wear.{k}", wear.get(k, 0.0)) for k in WEAR_KEYS}}

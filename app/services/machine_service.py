@@ -76,10 +76,6 @@ STATE_ACTIVE_OFFSET = "active_offset"
 STATE_TOOL = "tool"
 
 
-def _finite(value, field: str) -> float:
-    return checks.number(value, field)
-
-
 def alarm_dict(alarm: Alarm) -> dict:
     """An alarm with the manual's remedy (seed 001 turning §11, "说明，消除"), "" where the catalogue has none."""
     definition = alarm_by_number(alarm.code)
@@ -379,7 +375,7 @@ class MachineService:
     def retract_tool_axis(self, distance: float | None = None) -> dict:
         """Retract up along the tool axis (to the limits by default) before a swivel (jog-measuring §11 Q9)."""
         if distance is not None:
-            distance = _finite(distance, "distance")
+            distance = checks.number(distance, "distance")
         head = self._swivel_head()
         if head is None:
             raise InvalidInput("this machine has no swivel kinematics", field="retract")
@@ -442,7 +438,7 @@ class MachineService:
     def _check_feed(self, feed, field: str = "feed") -> float | None:
         if feed is None:
             return None
-        feed = _finite(feed, field)
+        feed = checks.number(feed, field)
         if not 0 < feed <= MAX_FEED:
             raise InvalidInput(f"{field}: must be > 0 and <= {MAX_FEED:g} mm/min", field=field)
         return feed
@@ -476,7 +472,7 @@ class MachineService:
 
     def jog(self, axis: str, distance: float, feed: float | None = None) -> dict:
         axis = self._check_axis(axis)
-        distance = _finite(distance, "distance")
+        distance = checks.number(distance, "distance")
         if abs(distance) > MAX_TRAVEL:
             raise InvalidInput(f"distance: at most {MAX_TRAVEL:g} per jog", field="distance")
         feed = self._check_feed(feed)
@@ -538,7 +534,7 @@ class MachineService:
             if value is None:
                 continue
             axis = self._check_axis(axis, field=str(axis))
-            given[axis] = _finite(value, axis)
+            given[axis] = checks.number(value, axis)
         st = self._machine.status()
         if coords == "MCS":
             return {**{a: float(v) for a, v in st.mcs.items()}, **given}
@@ -556,17 +552,17 @@ class MachineService:
             raise InvalidInput("coords: must be WCS or MCS", field="coords")
         if not isinstance(direction, list | tuple) or len(direction) != 3:
             raise InvalidInput("direction: must be [dx, dy, dz]", field="direction")
-        d = np.array([_finite(v, f"direction.{i}") for i, v in enumerate(direction)])
+        d = np.array([checks.number(v, f"direction.{i}") for i, v in enumerate(direction)])
         norm = float(np.linalg.norm(d))
         if norm < 1e-9:
             raise InvalidInput("direction: must not be the zero vector", field="direction")
         d = d / norm
         if coords == "WCS":
             d = self._chain.wcs2bcs.dir_child2parent(d)
-        distance = _finite(distance, "distance")
+        distance = checks.number(distance, "distance")
         if not 0 < distance <= MAX_TRAVEL:
             raise InvalidInput(f"distance: must be > 0 and <= {MAX_TRAVEL:g}", field="distance")
-        feed = self._check_feed(_finite(feed, "feed"))
+        feed = self._check_feed(checks.number(feed, "feed"))
         self.interlock("probe")
         self._ensure_idle()
         with self._machine_errors():
@@ -628,7 +624,7 @@ class MachineService:
 
     def spindle_position(self, angle: float) -> dict:
         """SPOS (deg, 0..360): on a lathe the clamped workpiece turns with the main spindle."""
-        angle = _finite(angle, "angle")
+        angle = checks.number(angle, "angle")
         if not 0.0 <= angle <= 360.0:
             raise InvalidInput("angle: SPOS 0..360 degrees", field="angle")
         self.interlock("spindle")
@@ -638,7 +634,7 @@ class MachineService:
         return self.status()
 
     def set_override(self, percent: float) -> dict:
-        percent = _finite(percent, "feed")
+        percent = checks.number(percent, "feed")
         if not 0 <= percent <= 120:
             raise InvalidInput("feed: override must be 0..120 %", field="feed")
         with self._lock:

@@ -48,10 +48,6 @@ def _text(body: dict, key: str, required: bool = False) -> str | None:
     return value.strip()
 
 
-def _number(value: Any, field: str) -> float | None:
-    return checks.optional_number(value, field)
-
-
 def _limits(body: Any) -> dict[str, dict[str, float | None]]:
     """The job's characteristic limits: {name: {"nominal", "lower", "upper"}} (absolute values)."""
     if body is None:
@@ -65,7 +61,7 @@ def _limits(body: Any) -> dict[str, dict[str, float | None]]:
             raise InvalidInput("characteristics: names of 1..80 characters", field="characteristics")
         if not isinstance(limits, dict) or set(limits) - {"nominal", "lower", "upper"}:
             raise InvalidInput(f"{field}: an object with nominal, lower, upper", field=field)
-        item = {key: _number(limits.get(key), f"{field}.{key}") for key in ("nominal", "lower", "upper")}
+        item = {key: checks.optional_number(limits.get(key), f"{field}.{key}") for key in ("nominal", "lower", "upper")}
         lower, upper = item["lower"], item["upper"]
         if lower is not None and upper is not None and lower > upper:
             raise InvalidInput(f"{field}.lower: above the upper limit", field=f"{field}.lower")

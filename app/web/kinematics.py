@@ -9,9 +9,10 @@ import math
 
 from fastapi import APIRouter, Request
 
+from app import checks
 from app.access.deps import needs
 from app.deps import ServicesDep, WorkflowDep
-from app.errors import HmiError
+from app.errors import HmiError, InvalidInput
 from app.i18n import _
 from app.services.kinematics import KinematicsService
 
@@ -23,13 +24,12 @@ DEFAULTS = {"x": "", "y": "", "z": "", "diameter": "25", "axis": "", "positions"
 
 
 def _number(text: str, label: str) -> float:
+    """A typed number (app.checks.parse_number: ASCII digits, a point or a comma); the screen's
+    own words when it is none."""
     try:
-        value = float(str(text).strip().replace(",", "."))
-    except ValueError:
+        return checks.parse_number(text, label)
+    except InvalidInput:
         raise HmiError(_("%(field)s: enter a number", field=label), field=label) from None
-    if not math.isfinite(value):
-        raise HmiError(_("%(field)s: enter a number", field=label), field=label)
-    return value
 
 
 def _params(form: dict) -> dict:

@@ -22,6 +22,7 @@ import numpy as np
 from app.workflow import forms
 from app.workflow.context import MeasuringContext
 from engine import alarms
+from engine import checks as engine_checks
 from engine.checks import ParamError
 from engine.compensation import effective_radius
 from engine.kinematics import HEAD, TABLE, check_sphere_diameter, fit_axis, line_deviation, sphere_at_position
@@ -37,12 +38,6 @@ DEFAULT_PARTNER_DEG = 30.0
 ROTARY = ("A", "B", "C")
 
 
-def _number(value: Any, field: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise ParamError(field, f"{field}: a finite number is needed, got {value!r}")
-    return float(value)
-
-
 def _centre(value: Any) -> list[float]:
     if isinstance(value, dict):
         missing = [a for a in "XYZ" if a not in value]
@@ -51,7 +46,7 @@ def _centre(value: Any) -> list[float]:
         value = [value[a] for a in "XYZ"]
     if not isinstance(value, list | tuple) or len(value) != 3:
         raise ParamError("sphere.center", "sphere.center: [x, y, z] in MCS (mm) is needed")
-    return [_number(v, "sphere.center") for v in value]
+    return [engine_checks.param_real("sphere.center", v) for v in value]
 
 
 def validate(params: dict, plane: Plane) -> dict:
@@ -59,7 +54,7 @@ def validate(params: dict, plane: Plane) -> dict:
     sphere = params.get("sphere")
     if not isinstance(sphere, dict):
         raise ParamError("sphere", "sphere: {\"center\": [x, y, z], \"diameter\": mm} is needed")
-    diameter = _number(sphere.get("diameter"), "sphere.diameter")
+    diameter = engine_checks.param_real("sphere.diameter", sphere.get("diameter"))
     if not 0.0 < diameter <= 500.0:
         raise ParamError("sphere.diameter", "sphere.diameter: must be > 0 and <= 500 mm")
     axis = params.get("axis")
@@ -68,19 +63,19 @@ def validate(params: dict, plane: Plane) -> dict:
     positions = params.get("positions")
     if not isinstance(positions, list) or not 3 <= len(positions) <= MAX_POSITIONS:
         raise ParamError("positions", f"positions: a list of 3..{MAX_POSITIONS} angles (deg) is needed")
-    angles = [_number(v, "positions") for v in positions]
+    angles = [engine_checks.param_real("positions", v) for v in positions]
     if len({round(a, 6) for a in angles}) < 3:
         raise ParamError("positions", "positions: at least 3 different angles are needed")
     mode = params.get("mode", "check")
     if mode not in MODES:
         raise ParamError("mode", f"mode: \"check\" or \"optimise\", got {mode!r}")
-    clearance = _number(params.get("clearance", 5.0), "clearance")
+    clearance = engine_checks.param_real("clearance", params.get("clearance", 5.0))
     if not 0.5 <= clearance <= 50.0:
         raise ParamError("clearance", "clearance: 0.5 .. 50 mm")
     out = {"sphere": {"center": _centre(sphere.get("center")), "diameter": diameter}, "axis": axis,
            "positions": angles, "mode": MODES[mode], "clearance": clearance}
     if "partner_angle" in params:
-        partner = _number(params["partner_angle"], "partner_angle")
+        partner = engine_checks.param_real("partner_angle", params["partner_angle"])
         if not -180.0 <= partner <= 180.0 or abs(partner) < 5.0:
             raise ParamError("partner_angle", "partner_angle: 5° .. 180° (either sign): the inner head axis "
                              "tilts the probe off the outer one")
