@@ -41,6 +41,7 @@ from .polygon import convex_pieces
 from .roots import brentq
 
 ROOT_XTOL = 1e-13          # mm, brentq tolerance on the path parameter
+_RTOL = 4 * float(np.finfo(float).eps)
 _GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
 _EXTEND = 2000.0           # mm: cut-outs reach this far above the top face (open to the air)
 
@@ -51,9 +52,26 @@ class Primitive:
     def __init__(self, rotation: np.ndarray, centre) -> None:
         self.rotation = np.asarray(rotation, dtype=float)       # local -> MCS
         self.centre = np.asarray(centre, dtype=float)
+        # the same as plain floats (row-major): the contact search asks one point at a time,
+        # where numpy's cost per call is most of the work (issue 30 item 3)
+        self._r = tuple(float(v) for v in self.rotation.ravel())
+        self._c = (float(self.centre[0]), float(self.centre[1]), float(self.centre[2]))
 
     def to_local(self, p_in_mcs) -> np.ndarray:
         return self.rotation.T @ (np.asarray(p_in_mcs, dtype=float) - self.centre)
+
+    def _local(self, x: float, y: float, z: float) -> tuple[float, float, float]:
+        """``to_local`` of one point in plain floats: Rᵀ·(p − centre)."""
+        r = self._r
+        cx, cy, cz = self._c
+        dx, dy, dz = x - cx, y - cy, z - cz
+        return (r[0] * dx + r[3] * dy + r[6] * dz, r[1] * dx + r[4] * dy + r[7] * dz,
+                r[2] * dx + r[5] * dy + r[8] * dz)
+
+    def _local_dir(self, dx: float, dy: float, dz: float) -> tuple[float, float, float]:
+        r = self._r
+        return (r[0] * dx + r[3] * dy + r[6] * dz, r[1] * dx + r[4] * dy + r[7] * dz,
+                r[2] * dx + r[5] * dy + r[8] * dz)
 
     def local_sdf(self, x: float, y: float, z: float) -> float:  # pragma: no cover - abstract
         raise NotImplementedError
@@ -63,26 +81,37 @@ class Primitive:
         """Radius about ``centre`` of a sphere holding the solid."""
         raise NotImplementedError
 
-    def out_of_reach(self, c0: np.ndarray, d: np.ndarray, length: float, level: float) -> bool:
+    def out_of_reach(self, c0, d, length: float, level: float) -> bool:
         """True when no point of the path c0 + s·d, s in [0, length], comes within ``level`` of
         the solid (the bounding sphere proves it): the exact search can be skipped."""
-        rel = self.centre - c0
-        s = min(max(float(rel @ d), 0.0), length)
-        gap = float(np.linalg.norm(rel - s * d))
-        return gap > self.bound + max(level, 0.0) + 1e-9
+        return self._out_of_reach(_xyz(c0), _xyz(d), length, level)
+
+    def _out_of_reach(self, c0: tuple[float, float, float], d: tuple[float, float, float], length: float,
+                      level: float) -> bool:
+        cx, cy, cz = self._c
+        rx, ry, rz = cx - c0[0], cy - c0[1], cz - c0[2]
+        s = min(max(rx * d[0] + ry * d[1] + rz * d[2], 0.0), length)
+        gx, gy, gz = rx - s * d[0], ry - s * d[1], rz - s * d[2]
+        return math.sqrt(gx * gx + gy * gy + gz * gz) > self.bound + max(level, 0.0) + 1e-9
 
     def sdf(self, p_in_mcs) -> float:
-        q = self.to_local(p_in_mcs)
-        return self.local_sdf(q[0], q[1], q[2])
+        return self.local_sdf(*self._local(*_xyz(p_in_mcs)))
 
     def along(self, c0, d):
         """g(s) = sdf(c0 + s·d) as a fast scalar closure (convex in s)."""
-        q0 = self.to_local(c0)
-        qd = self.rotation.T @ np.asarray(d, dtype=float)
-        x0, y0, z0 = (float(v) for v in q0)
-        dx, dy, dz = (float(v) for v in qd)
+        return self._along(_xyz(c0), _xyz(d))
+
+    def _along(self, c0: tuple[float, float, float], d: tuple[float, float, float]):
+        x0, y0, z0 = self._local(*c0)
+        dx, dy, dz = self._local_dir(*d)
         f = self.local_sdf
         return lambda s: f(x0 + s * dx, y0 + s * dy, z0 + s * dz)
+
+
+def _xyz(p) -> tuple[float, float, float]:
+    """A point or direction as three plain floats."""
+    a = np.asarray(p, dtype=float).reshape(-1)
+    return float(a[0]), float(a[1]), float(a[2])
 
 
 class Box(Primitive):
@@ -118,10 +147,14 @@ class Cylinder(Primitive):
     def bound(self) -> float:
         return math.hypot(self.radius, self.hz)
 
-    def out_of_reach(self, c0: np.ndarray, d: np.ndarray, length: float, level: float) -> bool:
+    def _out_of_reach(self, c0: tuple[float, float, float], d: tuple[float, float, float], length: float,
+                      level: float) -> bool:
         """The cylinder lies in the capsule of its axis segment and radius (cut-outs are long)."""
-        axis = self.rotation[:, 2]
-        gap = _segment_distance(c0, d, length, self.centre - self.hz * axis, axis, 2.0 * self.hz)
+        r = self._r
+        axis = (r[2], r[5], r[8])
+        cx, cy, cz = self._c
+        foot = (cx - self.hz * axis[0], cy - self.hz * axis[1], cz - self.hz * axis[2])
+        gap = _segment_distance_xyz(c0, d, length, foot, axis, 2.0 * self.hz)
         return gap > self.radius + max(level, 0.0) + 1e-9
 
 
@@ -196,16 +229,30 @@ class Body:
     name: str = ""                                # what the operator reads ("spigot"); default: kind
 
     def sdf(self, p) -> float:
-        return max([self.solid.sdf(p)] + [-c.sdf(p) for c in self.cutouts])
+        return self._sdf(*_xyz(p))
+
+    def _sdf(self, x: float, y: float, z: float) -> float:
+        solid = self.solid
+        value = solid.local_sdf(*solid._local(x, y, z))
+        for c in self.cutouts:
+            cut = -c.local_sdf(*c._local(x, y, z))
+            if cut > value:
+                value = cut
+        return value
 
 
 def _segment_distance(p0, u, length_u: float, q0, v, length_v: float) -> float:
     """Distance between the segments p0 + s·u (s in [0, length_u]) and q0 + t·v (t in [0,
     length_v]); u, v unit vectors (the closest points by clamping, Ericson §5.1.9)."""
-    r = p0 - q0
-    b = float(u @ v)
-    c = float(u @ r)
-    f = float(v @ r)
+    return _segment_distance_xyz(_xyz(p0), _xyz(u), length_u, _xyz(q0), _xyz(v), length_v)
+
+
+def _segment_distance_xyz(p0, u, length_u: float, q0, v, length_v: float) -> float:
+    """``_segment_distance`` in plain floats (the same formulas)."""
+    rx, ry, rz = p0[0] - q0[0], p0[1] - q0[1], p0[2] - q0[2]
+    b = u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
+    c = u[0] * rx + u[1] * ry + u[2] * rz
+    f = v[0] * rx + v[1] * ry + v[2] * rz
     denom = 1.0 - b * b
     s = min(max((b * f - c) / denom, 0.0), length_u) if denom > 1e-12 else 0.0
     t = b * s + f
@@ -213,7 +260,10 @@ def _segment_distance(p0, u, length_u: float, q0, v, length_v: float) -> float:
         t, s = 0.0, min(max(-c, 0.0), length_u)
     elif t > length_v:
         t, s = length_v, min(max(b * length_v - c, 0.0), length_u)
-    return float(np.linalg.norm(p0 + s * u - (q0 + t * v)))
+    gx = p0[0] + s * u[0] - (q0[0] + t * v[0])
+    gy = p0[1] + s * u[1] - (q0[1] + t * v[1])
+    gz = p0[2] + s * u[2] - (q0[2] + t * v[2])
+    return math.sqrt(gx * gx + gy * gy + gz * gz)
 
 
 def _sublevel_interval(g, level: float, length: float) -> tuple[float, float] | None:
@@ -256,9 +306,9 @@ def _sublevel_interval(g, level: float, length: float) -> tuple[float, float] | 
     def shifted(s: float) -> float:
         return g(s) - level
 
-    start = 0.0 if g(0.0) <= level else brentq(shifted, 0.0, inside, xtol=ROOT_XTOL, rtol=4 * np.finfo(float).eps)
+    start = 0.0 if g(0.0) <= level else brentq(shifted, 0.0, inside, xtol=ROOT_XTOL, rtol=_RTOL)
     end = length if g(length) <= level else brentq(shifted, inside, length, xtol=ROOT_XTOL,
-                                                   rtol=4 * np.finfo(float).eps)
+                                                   rtol=_RTOL)
     return start, end
 
 
@@ -290,24 +340,25 @@ class Scene:
         """Composed signed distance (exact on faces; a bound near subtraction rims)."""
         if not self.bodies:
             return math.inf
-        return min(b.sdf(p_in_mcs) for b in self.bodies)
+        x, y, z = _xyz(p_in_mcs)
+        return min(b._sdf(x, y, z) for b in self.bodies)
 
     def contact_intervals(self, center0, direction, max_distance: float, radius: float):
         """Sorted, merged intervals of s in [0, max_distance] where the ball touches the solid."""
-        c0 = np.asarray(center0, dtype=float)
-        d = np.asarray(direction, dtype=float)
+        c0 = _xyz(center0)
+        d = _xyz(direction)
         pieces: list[tuple[float, float]] = []
         for body in self.bodies:
-            if body.solid.out_of_reach(c0, d, max_distance, radius):
+            if body.solid._out_of_reach(c0, d, max_distance, radius):
                 continue
-            main = _sublevel_interval(body.solid.along(c0, d), radius, max_distance)
+            main = _sublevel_interval(body.solid._along(c0, d), radius, max_distance)
             if main is None:
                 continue
             body_pieces = [main]
             for cutout in body.cutouts:
-                if cutout.out_of_reach(c0, d, max_distance, -radius):
+                if cutout._out_of_reach(c0, d, max_distance, -radius):
                     continue
-                cut = _sublevel_interval(cutout.along(c0, d), -radius, max_distance)
+                cut = _sublevel_interval(cutout._along(c0, d), -radius, max_distance)
                 if cut is None:
                     continue
                 body_pieces = [q for p in body_pieces for q in _subtract(p, cut, max_distance)]
