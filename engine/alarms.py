@@ -334,6 +334,11 @@ START_GUARD_LIMIT = _define(
     65301, "START_GUARD_LIMIT", "Start guard: the planned path leaves the travel range",
     "启动保护：计划路径超出行程范围",
     "Nothing moved. Start the measurement farther from the axis limits, or shorten the measuring path.")
+START_GUARD_OVERTRAVEL = _define(
+    65302, "START_GUARD_OVERTRAVEL", "Start guard: braking would push the probe beyond its permissible deflection",
+    "启动保护：制动会使测量头超出允许偏转",
+    "Nothing moved. Lower the measuring feed or the feed override until the braking distance stays within "
+    "the probe's permissible deflection, then press NC Start again.")
 # --- probe state at NC Start (design.md §10.4) ----------------------------------------------------
 # Product-defined (840D user alarm range): a measuring task starts only with a probe that can switch.
 PROBE_NOT_ARMED = _define(

@@ -12,6 +12,14 @@ contact of its own model along the stroke (the latch the program then continues 
 switch. Positions the model cannot judge (no model at all) are ``unknown``: the answer says so,
 never a silent pass.
 
+The probe's own reach (measuring-math §1.3): after the switch the axes run on by the braking
+distance s_b = 1000·v·t + 1000·v²/(2a) + v[m/min]/Kv (v the measuring feed in effect in m/s, t
+the signal delay, a the deceleration, Kv the position loop gain), or to the stroke's programmed
+end if that comes first. The ball is then deflected by min(pre-travel + s_b, stroke − contact)
+past the surface; beyond the probe's permissible deflection the stylus breaks (61302), so such a
+probing move is ``overtravel`` (refused). The contact is the model's first contact, else the
+nominal surface the plan expects, else the stroke's start (the worst case).
+
 Geometry: signed distances of extrusions (a polygon or circle in its local xy, height along its
 local z) and spheres, composed like constructive solid geometry: a body is a solid minus its
 cut-outs (sdf = max(sdf_P, −sdf_N)), the model the union of bodies (min). The contact of a ball
@@ -236,6 +244,43 @@ def first_contact(model: ProtectionModel, c0: npt.ArrayLike, c1: npt.ArrayLike, 
     return s, name          # a grazing pass that never resolves: treated as a contact
 
 
+# --- the probe's own reach (measuring-math §1.3) -----------------------------------------------
+
+def braking_distance(feed_mm_min: float, latency_s: float, decel_m_s2: float, kv: float) -> float:
+    """s_b [mm] = 1000·v·t + 1000·v²/(2·a) + Δs, Δs = v[m/min]/Kv (measuring-math §1.3): ``feed``
+    in mm/min (v in m/s for the first two terms, m/min for the following error), t in s, a in
+    m/s², Kv in (m/min)/mm."""
+    v_m_s = float(feed_mm_min) / 60000.0
+    v_m_min = float(feed_mm_min) / 1000.0
+    return 1000.0 * v_m_s * float(latency_s) + 1000.0 * v_m_s * v_m_s / (2.0 * float(decel_m_s2)) + v_m_min / float(kv)
+
+
+@dataclass(frozen=True)
+class Braking:
+    """What the control knows of its braking behind a switch and the probe's permissible
+    deflection (mm); ``override`` the feed override (percent) the measuring feed runs at;
+    ``pretravel`` (mm) what the ball moves past the contact before it switches."""
+
+    latency_s: float
+    decel: float
+    kv: float
+    max_deflection: float
+    override: float = 100.0
+    pretravel: float = 0.0
+
+    def feed_in_effect(self, feed: float) -> float:
+        return float(feed) * float(self.override) / 100.0
+
+    def distance(self, feed: float) -> float:
+        """s_b at the programmed ``feed`` (mm/min) under the override."""
+        return braking_distance(self.feed_in_effect(feed), self.latency_s, self.decel, self.kv)
+
+    def deflection(self, feed: float, past_contact: float) -> float:
+        """How far the ball is pushed past the surface: pre-travel + s_b, at most the stroke's
+        remaining length ``past_contact`` behind the contact (the axes stop at the block's end)."""
+        return min(self.pretravel + self.distance(feed), max(0.0, float(past_contact)))
+
+
 # --- the check ------------------------------------------------------------------------------
 
 @dataclass(frozen=True)
@@ -259,10 +304,28 @@ class Placement:
 
 
 @dataclass(frozen=True)
+class Reach:
+    """A probing move's braking distance s_b, the deflection it gives and the permissible one (mm)."""
+
+    braking: float
+    deflection: float
+    max_deflection: float
+
+    @property
+    def beyond(self) -> bool:
+        return self.deflection > self.max_deflection + 1e-9
+
+
+REFUSED = ("collision", "limit", "overtravel")
+
+
+@dataclass(frozen=True)
 class Segment:
     """One planned motion: ``kind`` "move"/"probe", plan coordinates, and the guard's verdict
-    (``clear``, ``collision``, ``limit``, ``unknown``; a probing move ``contact`` or
-    ``no_switch``); ``where`` the contact point (plan coordinates) and ``body`` what is hit."""
+    (``clear``, ``collision``, ``limit``, ``unknown``; a probing move ``contact``, ``no_switch``
+    or ``overtravel``: its braking would push the probe beyond its permissible deflection);
+    ``where`` the contact point (plan coordinates) and ``body`` what is hit; ``braking`` the
+    braking distance s_b and ``deflection`` the deflection it gives (mm) of a probing move."""
 
     index: int
     label: str
@@ -273,10 +336,24 @@ class Segment:
     body: str = ""
     where: FloatArray | None = None
     axis: str = ""
+    feed: float | None = None
+    reach: Reach | None = None
+
+    @property
+    def braking(self) -> float | None:
+        return None if self.reach is None else self.reach.braking
+
+    @property
+    def deflection(self) -> float | None:
+        return None if self.reach is None else self.reach.deflection
+
+    @property
+    def max_deflection(self) -> float | None:
+        return None if self.reach is None else self.reach.max_deflection
 
     @property
     def refused(self) -> bool:
-        return self.verdict in ("collision", "limit")
+        return self.verdict in REFUSED
 
 
 @dataclass(frozen=True)
@@ -307,11 +384,12 @@ def _limit_axis(model: ProtectionModel, axes: FloatArray) -> str:
 
 
 def check_program(program: Generator[Step, Latch | None, object], start: npt.ArrayLike,
-                  model: ProtectionModel, placement: Placement) -> GuardReport:
+                  model: ProtectionModel, placement: Placement, braking: Braking | None = None) -> GuardReport:
     """Drive ``program`` from ``start`` (plan coordinates) against ``model``; stop at the first
     refused segment. Probing moves are answered with the model's first contact along the stroke
     (the latch = the NC reference there), so the path after a touch is the one the machine will
-    take when the part is where the model says."""
+    take when the part is where the model says. With ``braking`` every probing move is also
+    checked against the probe's permissible deflection (``probe_reach``)."""
     pos = np.asarray(start, dtype=float)
     segments: list[Segment] = []
     r = placement.ball_radius
@@ -345,7 +423,14 @@ def check_program(program: Generator[Step, Latch | None, object], start: npt.Arr
                     segments.append(Segment(len(segments) + 1, step.label, "probe", pos, end, "limit", axis=axis))
                     break
                 where = None if hit_s is None else pos + float(hit_s) * d
-                segments.append(Segment(len(segments) + 1, step.label, "probe", pos, end, verdict, body, where))
+                reach = probe_reach(step, hit_s if verdict == "contact" else None, braking)
+                if reach is not None and reach.beyond:
+                    verdict = "overtravel"
+                seg = Segment(len(segments) + 1, step.label, "probe", pos, end, verdict, body, where,
+                              feed=float(step.feed), reach=reach)
+                segments.append(seg)
+                if seg.refused:
+                    break
                 if where is not None:
                     pos = where
                     reply = Latch(triggered=True, rec=where.copy())
@@ -357,6 +442,18 @@ def check_program(program: Generator[Step, Latch | None, object], start: npt.Arr
     except MeasuringError:
         pass                 # the program stops itself (no switch: 61301) before any harm
     return GuardReport(tuple(segments), complete, tuple(directions))
+
+
+def probe_reach(step: ProbeStep, contact_s: float | None, braking: Braking | None) -> Reach | None:
+    """The reach of a probing move; None without braking data. ``contact_s``: the travel to the
+    first contact (None: the nominal surface the plan expects, else the stroke's start, the
+    worst case)."""
+    if braking is None:
+        return None
+    if contact_s is None:
+        contact_s = step.expected if step.expected is not None else 0.0
+    return Reach(braking.distance(step.feed), braking.deflection(step.feed, float(step.distance) - float(contact_s)),
+                 float(braking.max_deflection))
 
 
 def _move_segment(index: int, label: str, a: FloatArray, b: FloatArray, model: ProtectionModel,
@@ -380,6 +477,11 @@ def segments_to_api(segments: Sequence[Segment], axes: Sequence[str] = AXES, poi
     def xyz(v: FloatArray | None) -> dict[str, float] | None:
         return None if v is None else {a: float(x) for a, x in zip(axes, v, strict=True)}
 
+    def reach(s: Segment) -> dict[str, Any]:
+        if s.kind != "probe":
+            return {}
+        return {"feed": s.feed, "braking": s.braking, "deflection": s.deflection, "max_deflection": s.max_deflection}
+
     return [{"point": point, "step": s.index, "label": s.label, "kind": s.kind, "from": xyz(s.start),
              "to": xyz(s.end), "verdict": s.verdict, "body": s.body or None, "at": xyz(s.where),
-             "axis": s.axis or None} for s in segments]
+             "axis": s.axis or None, **reach(s)} for s in segments]

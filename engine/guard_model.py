@@ -5,6 +5,10 @@ The machine hands its model of the work space as data (``{"bodies": [{"solid": {
 ``rotation`` (local -> MCS, 3x3), ``centre`` and its shape: ``sphere`` + ``radius``, a circle
 ``radius`` or a ``polygon`` with ``half_height`` along local z. No model (None): every
 positioning move is ``unknown``.
+
+The probe's reach (measuring-math §1.3) comes as its own data (``braking_from_data``): the signal
+delay ``latency_s``, the deceleration ``decel``, the loop gain ``kv`` and the permissible
+deflection of the probe that switches; none: the reach is not checked.
 """
 
 from __future__ import annotations
@@ -14,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from engine.guard import Body, ProtectionModel, Solid
+from engine.guard import Body, Braking, ProtectionModel, Solid
 
 
 def _solid(data: Mapping[str, Any]) -> Solid:
@@ -33,3 +37,16 @@ def model_from_data(data: Mapping[str, Any] | None) -> ProtectionModel:
                    for b in data.get("bodies", ()))
     limits = {str(a): (float(v[0]), float(v[1])) for a, v in (data.get("limits") or {}).items()}
     return ProtectionModel(bodies, limits, True)
+
+
+def braking_from_data(data: Mapping[str, Any] | None, probe: str | None, override: float = 100.0) -> Braking | None:
+    """The reach check's data for the probe ``probe`` ("workpiece" or "tool") switching at the
+    feed override ``override`` (percent); None when the control has no braking data or that
+    probe has no permissible deflection (it is not broken by overtravel)."""
+    if data is None or probe is None:
+        return None
+    limit = (data.get("max_deflection") or {}).get(probe)
+    if limit is None:
+        return None
+    return Braking(latency_s=float(data["latency_s"]), decel=float(data["decel"]), kv=float(data["kv"]),
+                   max_deflection=float(limit), override=float(override))

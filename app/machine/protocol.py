@@ -260,6 +260,16 @@ class ProtectedSpace(Protocol):
 
 
 @runtime_checkable
+class ProbeReach(Protocol):
+    """Optional: a control that knows how far its axes run on behind a probe switch (the start
+    guard's reach check, measuring-math §1.3, issue 24 §1) and the probes' permissible deflection."""
+
+    def probe_braking(self) -> dict:
+        """``{"latency_s": t [s], "decel": a [m/s²], "kv": Kv [(m/min)/mm], "max_deflection":
+        {"workpiece": mm, "tool": mm or None}}`` (None: that probe is not broken by overtravel)."""
+
+
+@runtime_checkable
 class FrameCapacity(Protocol):
     """Optional: a control that cannot hold every frame the HMI offers (LinuxCNC: no tilted G54)."""
 

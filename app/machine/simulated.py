@@ -193,6 +193,18 @@ class SimulatedControl:
             self._spindle_speed = 0.0          # NC Reset ends M3/M4 like a real control
             self._alarms.reset()
 
+    def probe_braking(self) -> dict:
+        """The braking behind a switch and the probes' permissible deflection (protocol.ProbeReach):
+        the machine data of the scenario's ``machine`` section, measuring-math §1.3. A tool probe
+        without ``max_deflection`` (the milling machine's) is not broken by overtravel."""
+        m, sc = self._scenario.machine, self._scenario
+        tool_probe = getattr(sc, "tool_probe", None)
+        tool_limit = getattr(tool_probe, "max_deflection", None) if tool_probe is not None else None
+        probe = getattr(sc, "probe", None)
+        return {"latency_s": float(m.latency_s), "decel": float(m.decel), "kv": float(m.kv),
+                "max_deflection": {"workpiece": None if probe is None else float(probe.max_deflection),
+                                   "tool": None if tool_limit is None else float(tool_limit)}}
+
     def stop(self) -> None:
         """Stop motion without an alarm (jog key released)."""
         self._motion.stop()

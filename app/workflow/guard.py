@@ -5,7 +5,12 @@ a refused path answers 409 ``guard`` naming the alarm and the segment, and nothi
 The model comes from the machine (``protection_model()``: the simulator's is its work space); a
 controller without one gives the verdict ``unknown`` for every positioning move, shown in the
 plan and the session's warnings (never a silent pass). Tool measuring (the cutter, MCS
-coordinates) and the lathe tasks are not checked: their plan says ``unknown``.
+coordinates), the lathe tasks and ``kinematics.measure`` are not checked for collisions: their
+plan says ``unknown`` and NC Start warns (``NOT_MODELLED``).
+
+Every task's probing moves are checked against the probe's own reach (measuring-math §1.3) when
+the machine knows its braking (``ProbeReach``): braking behind the switch beyond the permissible
+deflection is refused with 65302 before anything moves.
 """
 
 from __future__ import annotations
@@ -13,17 +18,26 @@ from __future__ import annotations
 import numpy as np
 
 from app.errors import ConflictError
-from app.machine.protocol import ProtectedSpace
+from app.i18n import N_
+from app.machine.protocol import ProbeReach, ProtectedSpace
 from app.workflow.executor import StepExecutor
 from engine import alarms
-from engine.guard import GuardReport, Placement, Segment, check_program, segments_to_api
-from engine.guard_model import model_from_data
+from engine.guard import Braking, GuardReport, Placement, Segment, check_program, probe_reach, segments_to_api
+from engine.guard_model import braking_from_data, model_from_data
 from engine.plan import ideal_path
 from engine.plan_workpiece import ball_offset
 from engine.types import MoveStep, ProbeStep
 
-UNKNOWN_WARNING = ("Start guard: the control has no model of the work space: the path is not "
-                   "checked for collisions; watch the probe")
+UNKNOWN_WARNING = N_("Start guard: the control has no model of the work space: the path is not "
+                     "checked for collisions; watch the probe")
+NOT_MODELLED = {      # why a task's path is not checked for collisions (issue 24 §1: say so)
+    "tool": N_("Start guard: tool measuring is not checked for collisions (the HMI has no model of the "
+               "cutter around the tool probe); watch the tool"),
+    "lathe": N_("Start guard: the lathe tasks are not checked for collisions (the HMI has no model of "
+                "the turned part, the chuck and the turret); watch the probe"),
+    "kinematics": N_("Start guard: the kinematics measurement is not checked for collisions (the guard "
+                     "does not model the swivel moves); watch the probe"),
+}
 
 
 class GuardRefused(ConflictError):
@@ -33,6 +47,26 @@ class GuardRefused(ConflictError):
 def protection_data(machine) -> dict | None:
     """The control's model of its work space; None: it has none (the path is not checked)."""
     return machine.protection_model() if isinstance(machine, ProtectedSpace) else None
+
+
+def not_modelled_warning(spec) -> str:
+    """The note NC Start gives for a task the guard does not check for collisions."""
+    if getattr(spec, "lathe", False):
+        return NOT_MODELLED["lathe"]
+    if spec.probe_used == "tool" or not spec.needs_probe:
+        return NOT_MODELLED["tool"]
+    return NOT_MODELLED["kinematics"]
+
+
+def braking_for(machine, spec) -> Braking | None:
+    """The reach check's data for the probe ``spec`` switches with (None: not checked). The
+    override is the one in effect, at least 100 % (it may be turned up during the measurement)."""
+    if not isinstance(machine, ProbeReach):
+        return None
+    read = getattr(machine, "status", None)
+    status = read() if callable(read) else None
+    override = max(100.0, float(getattr(status, "feed_override", 100.0) or 100.0))
+    return braking_from_data(machine.probe_braking(), spec.probe_used, override)
 
 
 def guarded(spec) -> bool:
@@ -48,32 +82,39 @@ def check_point(machine, spec, params: dict, n: int, ctx) -> tuple[GuardReport, 
     coords = spec.coords_for(params, plan_ctx)
     start = executor.current(coords)
     program = spec.program(params, n, start, plan_ctx)
+    braking = braking_for(machine, spec)
     if not guarded(spec) or coords != "WCS":
-        return _unknown(ideal_path(program, start)), coords
+        return _unknown(ideal_path(program, start), start, braking), coords
     wcs2bcs = ctx.chain().wcs2bcs
     tip = executor.tip_conversion
     placement = Placement(rotation=np.asarray(wcs2bcs.rotation, dtype=float),
                           ball_shift=np.asarray(wcs2bcs.child2parent(ball_offset(plan_ctx)), dtype=float),
                           axes_shift=np.asarray(tip.axes_for_tip(np.zeros(3), "WCS"), dtype=float),
                           ball_radius=float(plan_ctx.probe.ball_diameter) / 2.0)
-    return check_program(program, start, model_from_data(protection_data(machine)), placement), coords
+    return check_program(program, start, model_from_data(protection_data(machine)), placement, braking), coords
 
 
-def _unknown(steps) -> GuardReport:
+def _unknown(steps, start, braking: Braking | None = None) -> GuardReport:
+    """A path the guard has no model for: every segment ``unknown`` (from ``start``); the probing
+    moves still checked against the probe's reach (at the nominal surface, else the stroke's start)."""
     segments: list[Segment] = []
     directions = []
-    pos = None
+    pos = np.asarray(start, dtype=float)
     for step in steps:
         if isinstance(step, ProbeStep):
             directions.append(np.asarray(step.direction, dtype=float))
         if isinstance(step, MoveStep):
             target = np.asarray(step.target, dtype=float)
-            segments.append(Segment(len(segments) + 1, step.label, "move", target if pos is None else pos,
-                                    target, "unknown"))
+            segments.append(Segment(len(segments) + 1, step.label, "move", pos, target, "unknown"))
             pos = target
-        elif isinstance(step, ProbeStep) and pos is not None:
+        elif isinstance(step, ProbeStep):
             end = pos + float(step.distance) * np.asarray(step.direction, dtype=float)
-            segments.append(Segment(len(segments) + 1, step.label, "probe", pos, end, "unknown"))
+            reach = probe_reach(step, None, braking)
+            beyond = reach is not None and reach.beyond
+            segments.append(Segment(len(segments) + 1, step.label, "probe", pos, end,
+                                    "overtravel" if beyond else "unknown", feed=float(step.feed), reach=reach))
+            if beyond:
+                break
             travel = step.expected if step.expected is not None else step.distance / 2.0
             pos = pos + float(travel) * np.asarray(step.direction, dtype=float)
     return GuardReport(tuple(segments), True, tuple(directions))
@@ -98,6 +139,12 @@ def refusal_error(report: GuardReport, n: int, axes: tuple[str, ...], params: di
     if seg.verdict == "limit":
         alarm = alarms.START_GUARD_LIMIT
         what = f"{label} would leave the travel range of axis {seg.axis}"
+    elif seg.verdict == "overtravel":
+        alarm = alarms.START_GUARD_OVERTRAVEL
+        what = (f"{label} would push the probe {float(seg.deflection or 0.0):.3f} mm past the surface: braking at "
+                f"the measuring feed {float(seg.feed or 0.0):g} mm/min takes {float(seg.braking or 0.0):.3f} mm "
+                f", beyond its permissible deflection of "
+                f"{float(seg.max_deflection or 0.0):g} mm")
     else:
         alarm = alarms.START_GUARD_COLLISION
         at = seg.where if seg.where is not None else seg.end

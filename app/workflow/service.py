@@ -341,7 +341,8 @@ class WorkflowService:
             raise WorkflowError(409, "override_mismatch", warnings[-1])
         # the start guard runs the point's program once; the probe-trust check reads its probing
         # directions from that run (a second run with ideal latches only when it cannot tell)
-        guarded = session.guard and guard.guarded(spec)
+        # every task: the collisions where the guard has a model, the probe's reach always
+        guarded = session.guard
         report = self._guard_report(session, spec, n, ctx) if guarded else None
         directions = guard.ideal_directions(report) if isinstance(report, guard.GuardReport) else None
         distrust = probe_trust.findings(spec, session.params, n, ctx, self._env.machine, directions)
@@ -349,7 +350,7 @@ class WorkflowService:
             raise WorkflowError(409, distrust[0].code, distrust[0].message)
         warnings += [f.message for f in distrust]
         if guarded:
-            warnings += self._guard_verdict(report, session, n)
+            warnings += self._guard_verdict(report, session, spec, n)
         session.warnings = warnings
         session.running = True
         session.last_alarm = None
@@ -369,9 +370,9 @@ class WorkflowService:
             return exc
 
     def _guard_verdict(self, report: guard.GuardReport | Exception | None, session: MeasureSession,
-                       n: int) -> list[str]:
+                       spec: TaskSpec, n: int) -> list[str]:
         """The start guard (issue 24 §1): refuse before any motion (409 ``guard``); the warning
-        when the control has no model to check against."""
+        when the control has no model to check against, or the task is not modelled."""
         if isinstance(report, Exception):
             raise report
         if report is None:
@@ -379,6 +380,8 @@ class WorkflowService:
         refused = guard.refusal_error(report, n, ("X", "Y", "Z"), session.params)
         if refused is not None:
             raise refused
+        if not guard.guarded(spec):
+            return [guard.not_modelled_warning(spec)]
         return [guard.UNKNOWN_WARNING] if report.unknown else []
 
     def plan(self, session_id: str, point: int | None = None) -> dict:

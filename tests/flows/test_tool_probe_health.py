@@ -35,7 +35,8 @@ def _calibrated(api: Api) -> dict:
 def test_tool_measuring_carries_the_tool_probes_calibration(api):
     record = _calibrated(api)
     answer = api.length(CUTTER_T)
-    assert answer["warnings"] == []
+    # no calibration warning; only the start guard's note that tool measuring is not modelled (issue 24 §1)
+    assert [w for w in answer["warnings"] if not w.startswith("Start guard: tool measuring")] == []
     assert answer["calibration_id"] == record["calibration_id"]
     assert answer["calibration"]["probe"] == "tool" and answer["calibration"]["valid"] is True
     assert ok(api.c.get(f"/api/log/{answer['log_id']}"))["calibration_id"] == record["calibration_id"]

@@ -1,0 +1,98 @@
+"""The start guard on the lathe (issue 24 §1): the HMI has no model of the turned part, the chuck
+and the turret, so the lathe tasks are not checked for collisions; NC Start says so in its
+warnings and the plan's positioning moves are ``unknown`` (no silent pass). The probe's own
+reach (measuring-math §1.3) is checked: a measuring feed whose braking would push the tool probe
+beyond its permissible deflection (1 mm in turning.md §10.2's scenario) is refused before motion.
+
+Truth: the scenario's machine data (latency 0 s, deceleration 1 m/s², Kv 1 (m/min)/mm, the lathe
+scenario's defaults) in the formula worked by hand, and the simulator, which with the guard off
+pushes the tool probe beyond its deflection (a collision) at the same feed."""
+
+from __future__ import annotations
+
+import pytest
+from lathe_kit import Lathe, make_client
+
+TOOL_PROBE_LIMIT = 1.0
+
+
+def braking_by_hand(feed_mm_min: float, t: float = 0.0, a: float = 1.0, kv: float = 1.0) -> float:
+    """s_b = 1000·v·t + 1000·v²/(2a) + v[m/min]/Kv, v in m/s."""
+    v = feed_mm_min / 60000.0
+    return 1000.0 * v * t + 1000.0 * v * v / (2.0 * a) + (feed_mm_min / 1000.0) / kv
+
+
+@pytest.fixture
+def lathe(tmp_path):
+    with make_client(tmp_path) as client:
+        yield Lathe(client)
+
+
+def _tool_in_front_of_the_probe(lathe: Lathe) -> None:
+    """As test_lathe_api's incremental variant: T3's nose 30 mm above the tool probe's X- face."""
+    lathe.tool(3)
+    lathe.tip_to(3, 430.0, 208.0)
+
+
+def _calibrated_tool_probe(lathe: Lathe) -> None:
+    """test_lathe_api's 1-C: the X- face calibrated with T7 at the default feed."""
+    lathe.tool(7)
+    lathe.tip_to(7, 430.0, 205.0)
+    answer = lathe.task("lathe.toolprobe.calibrate", {"axis": "X", "incremental": True, "direction": "-",
+                                                      "measuring_path": 20})
+    assert answer["result"]["trigger"]["X-"] == pytest.approx(400.25, abs=1e-9)
+
+
+def _stored(lathe: Lathe) -> dict:
+    return {"tool": lathe.ok(lathe.c.get("/api/tools/3")), "log": lathe.ok(lathe.c.get("/api/log")),
+            "tool_probe": lathe.ok(lathe.c.get("/api/tool-probes/1"))}
+
+
+MEASURE = {"axis": "X", "incremental": True, "direction": "-", "measuring_path": 20}
+
+
+def test_a_feed_beyond_the_tool_probes_deflection_is_refused_before_motion(lathe):
+    feed = 1200.0                     # 0.02 m/s: 0.2 mm + 1.2 mm = 1.4 mm > 1 mm
+    assert braking_by_hand(feed) == pytest.approx(1.4, abs=1e-12)
+    _tool_in_front_of_the_probe(lathe)
+    before, data = lathe.status(), _stored(lathe)
+    session = lathe.ok(lathe.c.post("/api/measure", json={"task": "lathe.tool.measure",
+                                                          "params": {**MEASURE, "feed": feed}}))
+    plan = lathe.ok(lathe.c.get(f"/api/measure/{session['id']}/plan"))
+    assert plan["verdict"] == "refused"
+    answer = lathe.c.post(f"/api/measure/{session['id']}/start", json={})
+    assert answer.status_code == 409, answer.text
+    error = answer.json()["error"]
+    assert error["code"] == "guard" and error["alarm"]["code"] == 65302
+    segment = error["segment"]
+    assert segment["kind"] == "probe" and segment["verdict"] == "overtravel"
+    assert segment["braking"] == pytest.approx(braking_by_hand(feed), abs=1e-9)
+    assert segment["max_deflection"] == TOOL_PROBE_LIMIT
+    after = lathe.status()
+    assert after["mcs"] == before["mcs"] and not after["alarms"] and not after["busy"]
+    assert _stored(lathe) == data
+
+
+def test_the_simulator_agrees_with_the_guard_off(lathe):
+    _tool_in_front_of_the_probe(lathe)
+    session = lathe.ok(lathe.c.post("/api/measure", json={"task": "lathe.tool.measure",
+                                                          "params": {**MEASURE, "feed": 1200.0, "guard": False}}))
+    answer = lathe.c.post(f"/api/measure/{session['id']}/start", json={})
+    assert answer.status_code == 409 and "61302" in answer.json()["error"]["message"], answer.text
+
+
+def test_a_feed_within_the_deflection_measures_and_says_what_is_not_checked(lathe):
+    feed = 600.0                      # 0.01 m/s: 0.05 mm + 0.6 mm = 0.65 mm < 1 mm
+    assert braking_by_hand(feed) == pytest.approx(0.65, abs=1e-12)
+    _calibrated_tool_probe(lathe)
+    _tool_in_front_of_the_probe(lathe)
+    session = lathe.ok(lathe.c.post("/api/measure", json={"task": "lathe.tool.measure",
+                                                          "params": {**MEASURE, "feed": feed}}))
+    plan = lathe.ok(lathe.c.get(f"/api/measure/{session['id']}/plan"))
+    assert plan["verdict"] == "unknown"                       # no model of the lathe's work space
+    assert all(s["verdict"] == "unknown" for s in plan["segments"])
+    probe = [s for s in plan["segments"] if s["kind"] == "probe"][0]
+    assert probe["braking"] == pytest.approx(0.65, abs=1e-9)
+    answer = lathe.ok(lathe.c.post(f"/api/measure/{session['id']}/start", json={}))
+    assert any(w.startswith("Start guard: the lathe tasks are not checked for collisions") for w in answer["warnings"])
+    assert answer["result"]["length"]["L1"]["actual"] == pytest.approx(100.70, abs=1e-9)     # the true L1 of T3
