@@ -63,6 +63,9 @@ def climb(items: list) -> n.Expr:
     """``operand (operator operand)*`` -> the tree of binary operations: left-associative, by
     ``PRIORITY``; one comparison per chain (``a < b < c`` means nothing on the 840D). An
     operator is ``(terminal, text, pos)``."""
+    if len(items) == 3:                         # one operator: nothing to weigh
+        _kind, text, pos = items[1]
+        return n.Binary(text.upper(), items[0], items[2], pos)
     operands: list[n.Expr] = [items[0]]
     operators: list[tuple[str, str, n.Pos]] = []
     comparison: tuple[str, str, n.Pos] | None = None

@@ -279,27 +279,30 @@ class _Line:
     def expr(self) -> n.Expr:
         """``unary (operator unary)*``, the operators applied by ``build.climb``."""
         first = self.unary()
-        if self.peek()[0] not in _BINARY:
+        toks = self.toks
+        if toks[self.at][0] not in _BINARY:
             return first
         items: list = [first]
-        while self.peek()[0] in _BINARY:
-            op = self.take()
-            items.append((op[0], op[1], self.pos(op)))
+        while toks[self.at][0] in _BINARY:
+            op = toks[self.at]
+            self.at += 1
+            items.append((op[0], op[1], n.Pos(self.line, op[2])))
             items.append(self.unary())
         return b.climb(items)
 
     def unary(self) -> n.Expr:
-        tok = self.peek()
+        tok = self.toks[self.at]
         if tok[0] in _PREFIX:
-            self.take()
-            return b.unary(tok[1], self.unary(), self.pos(tok))
+            self.at += 1
+            return b.unary(tok[1], self.unary(), n.Pos(self.line, tok[2]))
         return self.atom()
 
     def atom(self) -> n.Expr:
-        tok = self.take()
+        tok = self.toks[self.at]
+        self.at += 1                            # past the end only to give up below
         kind = tok[0]
         if kind == "INT_NUMBER" or kind == "NUMBER":
-            return n.Num(b.number_value(tok[1]), self.pos(tok))
+            return n.Num(b.number_value(tok[1]), n.Pos(self.line, tok[2]))
         if kind == "RPARAM":
             return b.rparam(tok[1], self.line, tok[2])
         if kind == "NAME":
