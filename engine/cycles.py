@@ -33,6 +33,7 @@ import numpy.typing as npt
 from engine import alarms
 from engine.compensation import effective_radius, make_touch
 from engine.fit import fit_circle
+from engine.params import MAX_CIRCLE_POINTS, MIN_CIRCLE_POINTS
 from engine.frames import Frame
 from engine.plan_base import Motion, PlanContext
 from engine.plan_workpiece import Program, ball_offset, circle_point
@@ -63,15 +64,16 @@ def _arc(m: Motion, centre: FloatArray, radius: float, plane: Plane, theta0: flo
 def angle_circle_program(params: dict[str, Any], start: FloatArray, ctx: PlanContext, label: str
                          ) -> Program[CirclePoint]:
     """CYCLE979 bore (``inner``) or shaft: ``params`` = {"center": (a, o) setpoint centre in the
-    plane, "diameter", "start_angle" (_STA1), "increment" (_INCA), "points" (3 or 4),
+    plane, "diameter", "start_angle" (_STA1), "increment" (_INCA), "points" (the manual's 3 or 4; up to 36),
     "inner" (bool), "circle_feed" (_RF, mm/min; None = positioning feed)}. Measuring height =
     the start height; the probe ends ``_FA`` before the last point."""
     plane = ctx.plane
     m = Motion(start, ctx, ball_offset=ball_offset(ctx))
     inner = bool(params["inner"])
     n = int(params["points"])
-    if n not in (3, 4):
-        raise MeasuringError(alarms.WRONG_VARIANT, f"CYCLE979 measures 3 or 4 points, not {n}")
+    if not MIN_CIRCLE_POINTS <= n <= MAX_CIRCLE_POINTS:
+        raise MeasuringError(alarms.WRONG_VARIANT, f"CYCLE979 measures {MIN_CIRCLE_POINTS}..{MAX_CIRCLE_POINTS} "
+                             f"points (the manual: 3 or 4), not {n}")
     rho = effective_radius(ctx.probe)
     fa = ctx.measuring_path
     rn = float(params["diameter"]) / 2.0

@@ -452,6 +452,7 @@ def measuring_cycle_gud(*, ev_count: int = 20, mv_count: int = 20, probe_records
         integer("_CALNUM", 0, text="calibration body number"),
         integer("_NMSP", 1, text="measurements at the same point"),
         integer("_K", 1, text="weighting factor of the mean value"),
+        integer("_NPTS", 0, text="touches on a circle, 3..36 (this HMI's extension; 0 = as the manual)"),
         # --- results (measuring-math §4.2) ------------------------------------------------------------------
         real("_OVR", shape=(32,), text="results, real"),
         integer("_OVI", shape=(14,), text="results, integer"),

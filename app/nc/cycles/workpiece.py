@@ -5,11 +5,13 @@
 |---|---|---|
 | CYCLE977 | 1/101 bore, 2/102 shaft, 3/103 slot, 4/104 web, 5/105 inner, 6/106 outer rectangle | hole.1, spigot.1, edge.distance (+, −), pocket.rect, spigot.rect |
 | CYCLE978 | 0 surface + tool offset, 100 surface + ZO | edge.set |
-| CYCLE979 | 1/101 bore, 2/102 shaft at an angle (3 or 4 points) | hole.1 / spigot.1 with the CYCLE979 plan (engine.cycles) |
+| CYCLE979 | 1/101 bore, 2/102 shaft at an angle (3 or 4 points; ``_NPTS`` 3..36) | hole.1 / spigot.1 with the CYCLE979 plan (engine.cycles) |
 | CYCLE998 | 105, 100105 one angle | edge.align |
 | CYCLE961 | 105/106 rectangle corner, 107/108 any corner, 117/118 from 4 given points | corner.right / corner.any with the cycle's points and directions |
 
 Hundreds digit 0: tool offset by ``_KNUM`` (or measure only for ``_KNUM=0``); 1: ZO ``_KNUM``.
+``_NPTS`` > 0 (this HMI's extension, not the manual's): CYCLE977 bore/shaft and CYCLE979 fit their
+circle to that many touches, as the JSON API's ``params.points`` (design.md §10.2).
 """
 
 from __future__ import annotations
@@ -32,6 +34,7 @@ from app.workflow.tasks import TASKS
 from engine import alarms
 from engine.compensation import effective_radius, trigger_radius
 from engine.cycles import angle_circle_program
+from engine.params import MAX_CIRCLE_POINTS, MIN_CIRCLE_POINTS
 from engine.plan_workpiece import edge_program
 from engine.tasks import evaluate
 from engine.types import MeasuringError
@@ -48,6 +51,30 @@ def _probe(env):
 
 def _position_feed(env) -> float:
     return float(env.setup().settings.position_feed)
+
+
+def circle_points(call: Call) -> int | None:
+    """``_NPTS``: the touches on a circle where a cycle fits one (this HMI's extension, as the
+    JSON API's ``params.points``, design.md §10.2), 3..36; 0: the manual's own number."""
+    n = call.integer("_NPTS")
+    if n == 0:
+        return None
+    if not MIN_CIRCLE_POINTS <= n <= MAX_CIRCLE_POINTS:
+        raise CycleAlarm(alarms.NC_VALUE_RANGE, f"_NPTS = {n}: the touches on a circle are "
+                         f"{MIN_CIRCLE_POINTS}..{MAX_CIRCLE_POINTS} (0: as the manual)")
+    return n
+
+
+def _with_points(call: Call, kind: int, params: dict) -> None:
+    """CYCLE977 bore and shaft (``kind`` 1, 2) fit their circle to ``_NPTS`` touches; the other
+    variants fit no circle and refuse it."""
+    n = circle_points(call)
+    if n is None:
+        return
+    if kind not in (1, 2):
+        raise CycleAlarm(alarms.NC_VALUE_RANGE, f"_NPTS = {n}: only bore and shaft (_MVAR 1, 2) fit a circle; "
+                         "set _NPTS=0 for slot, web and rectangles")
+    params["points"] = n
 
 
 def _ao_unit(plane, theta_deg: float) -> np.ndarray:
@@ -119,6 +146,7 @@ def cycle977(call: Call) -> None:
     tool = isinstance(target, dict)
     spec = TASKS[_977_TASKS[kind]]
     params: dict = {"setpoint": {a: sa, o: so}, "measurements": call.measurements()}
+    _with_points(call, kind, params)
     before_point = None
     axis = None
     if kind in (1, 2, 3, 4) and not setval > 0.0:
@@ -262,6 +290,11 @@ def cycle978(call: Call) -> None:
 
 # --- CYCLE979 (measuring-math §10) ---------------------------------------------------------------------
 
+def _points_979(call: Call) -> int:
+    """``_NPTS`` touches, else the manual's: ``_PRNUM`` 4th digit 0 = 3, 1 = 4 points."""
+    return circle_points(call) or (4 if digit_at(call.integer("_PRNUM"), 4) == 1 else 3)
+
+
 def cycle979(call: Call) -> None:
     v = call.variant
     if v in (3, 4, 103, 104):
@@ -277,7 +310,7 @@ def cycle979(call: Call) -> None:
     setval = call.length("_SETVAL")
     if not setval > 0.0:
         raise CycleAlarm(alarms.NC_VALUE_RANGE, f"_SETVAL = {setval:g}: the diameter must be > 0")
-    points = 4 if digit_at(call.integer("_PRNUM"), 4) == 1 else 3
+    points = _points_979(call)
     rf = call.real("_RF")
     plan = {"center": (cpa, cpo), "diameter": setval, "start_angle": call.real("_STA1"),
             "increment": call.real("_INCA"), "points": points, "inner": bore,
