@@ -33,8 +33,8 @@ import numpy.typing as npt
 from engine import alarms
 from engine.compensation import effective_radius, make_touch
 from engine.fit import fit_circle
-from engine.params import MAX_CIRCLE_POINTS, MIN_CIRCLE_POINTS
 from engine.frames import Frame
+from engine.params import MAX_CIRCLE_POINTS, MIN_CIRCLE_POINTS
 from engine.plan_base import Motion, PlanContext
 from engine.plan_workpiece import Program, ball_offset, circle_point
 from engine.planes import Plane
