@@ -21,6 +21,8 @@ from app import checks
 from app.errors import InvalidInput, NotFoundError
 from db import Database
 
+from .data_reset import clear_stored_data
+
 STATE_GROOVES = "lathe_grooves"
 GROOVE_RECORDS = 3                     # _CVAL[2] (turning.md §0.7)
 GROOVE_KEYS = ("x_minus", "x_plus", "bottom_z", "z_minus", "z_plus", "top_x", "bottom_x")
@@ -45,7 +47,7 @@ def seed(db: Database, scenario, reset: bool, tool_probe_number: int) -> None:
     probe's rough triggers, the grooves _KB; ``reset`` clears tools, offsets and records first."""
     with db.unit() as unit:
         if reset:
-            _clear(unit)
+            clear_stored_data(unit)
         present = {tool["t"] for tool in unit.list_tools()}
         if scenario.probe.t not in present:
             unit.put_tool(scenario.probe.t, probe_row(scenario.probe))
@@ -63,20 +65,6 @@ def seed(db: Database, scenario, reset: bool, tool_probe_number: int) -> None:
             records = [g.kb() for g in scenario.grooves][:GROOVE_RECORDS]
             records += [{} for _ in range(GROOVE_RECORDS - len(records))]
             unit.set_state(STATE_GROOVES, records)
-
-
-def _clear(unit) -> None:
-    """reset_data: no tools, zero offsets, empty probe and tool-probe records, no tool in the spindle."""
-    for tool in unit.list_tools():
-        unit.delete_tool(tool["t"])
-    for name in unit.offset_names():
-        unit.put_offset(name, {"trans": {}, "fine": {}, "rot": {}}, source="scenario",
-                        detail={"reason": "reset_data"})
-    for record in unit.list_probes():
-        unit.put_probe(record["number"], {})
-    for record in unit.list_tool_probes():
-        unit.put_tool_probe(record["number"], {})
-    unit.set_state("tool", None)
 
 
 def _seed_probe_record(unit, scenario, reset: bool) -> None:

@@ -64,6 +64,7 @@ from engine.frames import G500, SETFRAME, Frame, FrameChain, basic_frame_names, 
 from engine.planes import plane as plane_by_name
 
 from . import lathe_data
+from .data_reset import STATE_TOOL, clear_stored_data
 from .live import ChangeSignal
 from .settings import SettingsService
 
@@ -73,7 +74,6 @@ CHANNEL = "CHAN1"
 MAX_TRAVEL = 10_000.0            # mm; a bigger single move is a typo
 MAX_FEED = 50_000.0              # mm/min
 STATE_ACTIVE_OFFSET = "active_offset"
-STATE_TOOL = "tool"
 
 
 def alarm_dict(alarm: Alarm) -> dict:
@@ -873,15 +873,7 @@ class MachineService:
         with self._db.unit() as unit:
             tools = unit.list_tools()
             if reset:
-                for tool in tools:
-                    unit.delete_tool(tool["t"])
-                for name in unit.offset_names():
-                    unit.put_offset(name, {"trans": {}, "fine": {}, "rot": {}}, source="scenario",
-                                    detail={"reason": "reset_data"})
-                for record in unit.list_probes():
-                    unit.put_probe(record["number"], {})
-                for record in unit.list_tool_probes():
-                    unit.put_tool_probe(record["number"], {})
+                clear_stored_data(unit)         # the spindle empty too
             if reset or not tools:
                 unit.put_tool(sc.probe.t, {"name": "3D probe", "type": PROBE_TOOL_TYPE,
                                            "length": sc.probe.nominal_length,
@@ -891,8 +883,6 @@ class MachineService:
                     unit.put_tool(nominal.t, {"type": nominal.type, "length": nominal.nominal_length,
                                               "radius": nominal.nominal_radius,
                                               "wear": {"length": 0.0, "radius": 0.0}})
-            if reset:
-                unit.set_state(STATE_TOOL, None)
             if sc.tool_probe is not None:   # its disc diameter is commissioning data, like nominal tool data
                 n = 1 if reset else int(self._settings.get().tool_probe_number)
                 record = unit.get_tool_probe(n) or {}
