@@ -152,7 +152,7 @@ class ShdrAdapter:
         try:
             changes = self._read()
         except Exception as exc:          # a controller or database hiccup must not end the adapter
-            log.warning("MTConnect update failed: %s", exc)
+            log.warning("MTConnect update failed: %s", exc, exc_info=True)
             return
         waiting, self._waiting = self._waiting, set()
         for agent in waiting:

@@ -215,7 +215,7 @@ class Updates:
                 failing = False
             except Exception as exc:         # a controller or database hiccup must not end the endpoint
                 if not failing:
-                    log.warning("OPC UA update failed: %s", exc)
+                    log.warning("OPC UA update failed: %s", exc, exc_info=True)
                 failing = True
             try:
                 await asyncio.wait_for(stop.wait(), timeout=PERIOD_S)

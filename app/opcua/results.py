@@ -22,6 +22,7 @@ from asyncua import Node, Server, ua
 from asyncua.common.structures104 import new_struct, new_struct_field
 from asyncua.server.event_generator import EventGenerator
 
+from app.errors import NotFoundError
 from app.services import Services
 
 NODESET = Path(__file__).resolve().parents[2] / "vendor" / "node-opcua-nodesets-2.185.0" / \
@@ -114,11 +115,11 @@ class ResultManagement:
     def _part(self, text: str) -> dict | None:
         results = self._services.results
         assert results is not None
-        if not text.isdigit():
+        if not (text.isascii() and text.isdigit()):     # int() would read '²' or other scripts' digits
             return None
         try:
             return results.part(int(text))
-        except Exception:
+        except NotFoundError:           # no such part: the browse name reads nothing
             return None
 
     def _open_part_id(self) -> int | None:

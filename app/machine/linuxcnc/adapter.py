@@ -46,6 +46,7 @@ Decisions (where the spec leaves room):
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 import re
@@ -79,6 +80,8 @@ from .modules import LinuxCncMissing, import_linuxcnc
 from .own import OwnIni
 from .own_probe import OwnProbing
 from .process import LinuxCncProcess, LinuxCncStartError
+
+log = logging.getLogger(__name__)
 
 G5X = {"G54": 1, "G55": 2, "G56": 3, "G57": 4, "G58": 5, "G59": 6, "G59.1": 7, "G59.2": 8, "G59.3": 9}
 NO_SWITCH = 1e30
@@ -981,13 +984,13 @@ class LinuxCncMachine:
             with self._nml:
                 self._cmd.abort()
         except Exception:   # noqa: BLE001 - LinuxCNC may already be gone; it is stopped below anyway
-            pass
+            log.info("closing: stopping LinuxCNC's motion failed (it may be gone already)", exc_info=True)
         self._wait_idle()
         with self._lock:
             self._closed = True
         try:
             self._halcomp.exit()
-        except Exception:   # noqa: BLE001
-            pass
+        except Exception:   # noqa: BLE001 - closing goes on; the HAL component goes with its process
+            log.info("closing: the HAL component did not exit", exc_info=True)
         if not self.attached:                  # a LinuxCNC the HMI attached to runs on
             self._process.stop()

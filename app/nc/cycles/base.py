@@ -370,18 +370,11 @@ def run_cycle(ctx: CycleContext, host: CycleHost, number: int, body: Callable[[C
         call.ovi[3] = call.variant
         call.ovi[5] = call.integer("_PRNUM")
         body(call)
-    except CycleAlarm as exc:
+    except (CycleAlarm, MeasuringError) as exc:
         call.ovi[9] = exc.definition.number
-        call.write()
         raise ctx.alarm(exc.definition, f"CYCLE{number}: {exc.message}") from None
-    except MeasuringError as exc:
-        call.ovi[9] = exc.definition.number
+    finally:                        # _OVR/_OVI written whatever happened
         call.write()
-        raise ctx.alarm(exc.definition, f"CYCLE{number}: {exc.message}") from None
-    except Exception:
-        call.write()
-        raise
-    call.write()
     warning = alarms.by_number(call.ovi.get(9, 0)) if call.ovi.get(9) else None
     if warning is not None and warning.warning:
         ctx.warn(warning, f"CYCLE{number}: {warning.text}", stop=bool(ctx.variables.get("_CBIT", (2,))))

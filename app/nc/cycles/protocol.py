@@ -32,6 +32,7 @@ from datetime import datetime
 from typing import Protocol
 
 from app.nc.interpreter import CycleContext
+from app.nc.variables import VariableError
 from engine import alarms
 
 LEN_PROTOCOL_FILE = 100_000       # MD 11420 LEN_PROTOCOL_FILE of this control: characters per file
@@ -291,7 +292,7 @@ class ProtocolLog:
             name, index = (ref.group(1), int(ref.group(2))) if ref.group(1) else ("R", int(ref.group(3)))
             try:
                 value = v.get(name, (index,))
-            except Exception:
+            except VariableError:       # not defined, or no such element
                 raise ctx.alarm(alarms.PROTOCOL_VALUE, f"{text}: this variable cannot be logged") from None
             if name == "_TXT":
                 return str(value)
