@@ -429,6 +429,14 @@ class NcService:
         except NcStateError as exc:
             raise ConflictError(str(exc), code="busy") from None
         self._source, self._text, self._crash = source, text, None
+        self._clear_results()
+
+    def _clear_results(self) -> None:
+        """_OVR/_OVI to 0: the results shown belong to the run that made them (issue 29 item 6);
+        a program loaded or run again from its start has none yet. A cycle clears them too."""
+        for name, size in (("_OVR", 32), ("_OVI", 14)):
+            for i in range(size):
+                self.variables.set(name, 0.0 if name == "_OVR" else 0, (i,))
 
     def user_hook(self, name: str) -> str | None:
         """CYCLE198 / CYCLE199 (manual §3.2): the stored program of that name, or None."""
@@ -488,6 +496,7 @@ class NcService:
                 raise ConflictError("the channel has an alarm: press Reset first", code="alarm")
             if state == "done":
                 self.interpreter.load(self._text, self._source)
+                self._clear_results()
             self._check_writes(authorize)
             if single_block is not None:
                 self.single_block = bool(single_block)

@@ -22,6 +22,7 @@ from app.i18n import _
 from app.nc import cycle_forms
 from app.services.nc import MDA, NcSyntaxInput
 
+from . import nc_results
 from .templating import render_block, render_screen, url_path
 
 router = APIRouter()
@@ -42,12 +43,17 @@ def _listing(text: str, status: dict) -> list[dict]:
     return rows
 
 
-def _results(nc) -> list[dict]:
-    """The non-zero _OVR/_OVI elements of the last cycle."""
+def _results(nc) -> tuple[list[dict], str]:
+    """The non-zero _OVR/_OVI elements of the last cycle of this run, each with its meaning
+    (app/web/nc_results.py), and the cycle's name. A new run starts without results
+    (app/services/nc.py clears them when it loads a program)."""
     values = nc.read_variables(["_OVR", "_OVI"])
-    out = [{"name": f"_OVR[{i}]", "value": f"{v:.4f}"} for i, v in enumerate(values["_OVR"]) if v]
-    out += [{"name": f"_OVI[{i}]", "value": str(v)} for i, v in enumerate(values["_OVI"]) if v]
-    return out
+    return nc_results.results(values), nc_results.cycle_name(values)
+
+
+def has_blocks(text: str) -> bool:
+    """Whether ``text`` holds anything to run: a line with more than blanks or a comment (;)."""
+    return any(line.split(";", 1)[0].strip() for line in (text or "").splitlines())
 
 
 def channel_context(nc, error: dict | None = None, text: str | None = None) -> dict:
@@ -60,7 +66,8 @@ def channel_context(nc, error: dict | None = None, text: str | None = None) -> d
     rows = _listing(loaded, shown)
     if error:
         status = {**status, "alarm": error}
-    return {"nc": status, "rows": rows, "results": _results(nc), "syntax_error": error,
+    results, cycle = _results(nc)
+    return {"nc": status, "rows": rows, "results": results, "results_cycle": cycle, "syntax_error": error,
             "auto": status["program"] not in (None, MDA)}
 
 
@@ -95,6 +102,10 @@ def mda_start(request: Request, nc: NcDep, text: Annotated[str, Form()] = "",
     selected for AUTOMATIC; single block as the toggle says."""
     single = single_block is not None
     status = nc.status()
+    auto = status["program"] not in (None, MDA)
+    if not has_blocks(nc.loaded_text if auto else text):      # nothing would run: say so, change nothing
+        return _channel(request, nc, text=None if auto else text,
+                        message=_("The program is empty: nothing to run."), level="info")
     try:
         if status["program"] not in (None, MDA):
             nc.start(wait=False, single_block=single, authorize=authorizer(request))

@@ -39,6 +39,50 @@ def test_nc_start_single_block_highlights_the_block_and_shows_results(client):
     assert 'data-name="_OVR[4]">20.0000<' in html and 'data-name="_OVI[2]">977<' in html
 
 
+def test_results_are_named_with_their_meaning(client):
+    """Issue 29 item 6: next to each index what it means, from the manual's CYCLE977 result table
+    (bore: _OVR[1]/[2] setpoint centre, [4] actual diameter, [5]/[6] actual centre abscissa /
+    ordinate; _OVI[2] the cycle number, [3] the variant, [5] the probe number)."""
+    client.post("/mda/start", data={"text": BORE}, headers=HX)
+    html = wait_channel(client, "done")
+    assert 'id="nc-results-cycle">CYCLE977<' in html
+    for name, meaning in (("_OVR[1]", "setpoint centre abscissa"), ("_OVR[2]", "setpoint centre ordinate"),
+                          ("_OVR[4]", "actual diameter / width"), ("_OVR[5]", "actual centre abscissa"),
+                          ("_OVR[6]", "actual centre ordinate"), ("_OVI[2]", "measuring cycle"),
+                          ("_OVI[3]", "measuring variant"), ("_OVI[5]", "probe number")):
+        assert f'data-meaning="{name}">{meaning}<' in html, name
+    assert 'data-name="_OVR[4]">20.0000<' in html
+    html = client.get("/mda/channel?lang=de", headers=HX).text
+    assert 'data-meaning="_OVR[5]">Istwert Mittelpunkt Abszisse<' in html
+    html = client.get("/mda/channel?lang=zh", headers=HX).text
+    assert 'data-meaning="_OVR[4]">直径 / 宽度实际值<' in html
+
+
+def test_an_empty_program_says_so_and_changes_nothing(client):
+    before = client.app.state.services.nc.status()
+    for text in ("", "   \n\n", "; only a comment\n  ; another\n"):
+        html = client.post("/mda/start", data={"text": text}, headers=HX).text
+        assert "The program is empty: nothing to run." in html, repr(text)
+        assert client.app.state.services.nc.status()["state"] == before["state"]
+    html = client.post("/mda/start?lang=de", data={"text": ""}, headers=HX).text
+    assert "Das Programm ist leer" in html
+
+
+def test_a_new_run_starts_without_the_previous_programs_results(client):
+    client.post("/mda/start", data={"text": BORE}, headers=HX)
+    assert 'id="nc-results"' in wait_channel(client, "done")
+    client.post("/mda/start", data={"text": "N10 G500 G90 G0 Z-100\nN20 M30"}, headers=HX)
+    html = wait_channel(client, "done")
+    assert 'id="nc-results"' not in html and 'id="nc-results-cycle"' not in html
+    values = client.get("/api/nc/variables", params={"names": "_OVR,_OVI"}).json()
+    assert not any(values["_OVR"]) and not any(values["_OVI"])
+    # the same program again from its start (NC Start after the end): its own results once more
+    client.post("/mda/start", data={"text": BORE}, headers=HX)
+    wait_channel(client, "done")
+    client.post("/mda/start", data={"text": BORE}, headers=HX)
+    assert 'data-name="_OVR[4]">20.0000<' in wait_channel(client, "done")
+
+
 def test_a_syntax_error_is_shown_at_its_line_and_column(client):
     html = client.post("/mda/start", data={"text": "N10 G0 X10\nN20 G1 X"}, headers=HX).text
     assert 'data-alarm-line="2"' in html and "line 2, column 8" in html

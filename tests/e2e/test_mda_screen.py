@@ -51,3 +51,30 @@ def test_a_typo_is_shown_at_its_line_and_column(page, api):
     page.locator("#mda-start").click()
     expect(page.locator('#nc-listing tr[data-alarm-line="2"]')).to_contain_text("line 2, column 8")
     expect(page.locator("#nc-state")).to_have_text("idle")
+
+
+def test_results_say_what_they_mean_and_belong_to_their_run(page, api):
+    """Issue 29 item 6: each index with its meaning (the manual's CYCLE977 table), an empty
+    program says so, a new run starts without the previous program's results."""
+    assert api.post("/api/nc/reset").status_code == 200
+    page.goto("/mda")
+    page.locator("#single-block").uncheck()                             # the whole program at once
+    expect(page.locator("#nc-channel")).to_contain_text("SBL off")
+    page.locator("#mda-text").fill(PROGRAM)
+    page.locator("#mda-start").click()
+    expect(page.locator("#nc-state")).to_have_text("done", timeout=15000)
+    expect(page.locator("#nc-results-cycle")).to_have_text("CYCLE977")
+    expect(page.locator('#nc-results [data-meaning="_OVR[4]"]')).to_have_text("actual diameter / width")
+    expect(page.locator('#nc-results [data-meaning="_OVR[5]"]')).to_have_text("actual centre abscissa")
+    expect(page.locator('#nc-results [data-meaning="_OVI[2]"]')).to_have_text("measuring cycle")
+    meaning = page.locator('#nc-results [data-meaning="_OVR[4]"]').bounding_box()
+    value = page.locator('#nc-results dd[data-name="_OVR[4]"]').bounding_box()
+    assert meaning and value and abs(meaning["y"] - value["y"]) < 8          # on the value's line
+    page.locator("#mda-text").fill("; nothing but a comment\n")
+    page.locator("#mda-start").click()
+    expect(page.locator("#nc-channel .form-message")).to_have_text("The program is empty: nothing to run.")
+    page.locator("#mda-text").fill("N10 G500 G90 G0 Z-100\nN20 M30")
+    page.locator("#mda-start").click()
+    expect(page.locator("#nc-state")).to_have_text("done")
+    expect(page.locator('#nc-listing tr[data-line="2"]')).to_contain_text("M30")
+    expect(page.locator("#nc-results")).to_have_count(0)
