@@ -13,6 +13,7 @@ from app.i18n import N_, _
 
 ABSCISSA, ORDINATE, APPLICATE = N_("abscissa"), N_("ordinate"), N_("applicate")
 AOP = (ABSCISSA, ORDINATE, APPLICATE)
+Table = dict[int, tuple[str, ...]]       # index -> (text, axis word, ...)
 
 # _OVI: the same for every cycle (manual: result parameters of the measuring cycles)
 OVI = {0: N_("D number / ZO number"), 2: N_("measuring cycle"), 3: N_("measuring variant"),
@@ -21,17 +22,17 @@ OVI = {0: N_("D number / ZO number"), 2: N_("measuring cycle"), 3: N_("measuring
        11: N_("correction written (1 = yes)")}
 
 # _OVR[20], [27..31] of the workpiece cycles' tool-offset strategy (measuring-math §4.2)
-_STRATEGY = {20: (N_("compensation value"),), 27: (N_("zero offset range"),), 28: (N_("safe area"),),
+_STRATEGY: Table = {20: (N_("compensation value"),), 27: (N_("zero offset range"),), 28: (N_("safe area"),),
              29: (N_("dimension difference"),), 30: (N_("empirical value"),), 31: (N_("mean value"),)}
 
 # one meaning = (text,) or (text, axis word): "setpoint centre" + "abscissa"
-_SIZE_AND_CENTRE = {0: (N_("setpoint diameter / width"),), 1: (N_("setpoint centre"), ABSCISSA),
+_SIZE_AND_CENTRE: Table = {0: (N_("setpoint diameter / width"),), 1: (N_("setpoint centre"), ABSCISSA),
                     2: (N_("setpoint centre"), ORDINATE), 4: (N_("actual diameter / width"),),
                     5: (N_("actual centre"), ABSCISSA), 6: (N_("actual centre"), ORDINATE),
                     8: (N_("upper tolerance"),), 12: (N_("lower tolerance"),),
                     16: (N_("difference diameter / width"),), 17: (N_("difference centre"), ABSCISSA),
                     18: (N_("difference centre"), ORDINATE), **_STRATEGY}
-_RECTANGLE = {0: (N_("setpoint length"), ABSCISSA), 1: (N_("setpoint length"), ORDINATE),
+_RECTANGLE: Table = {0: (N_("setpoint length"), ABSCISSA), 1: (N_("setpoint length"), ORDINATE),
               2: (N_("setpoint centre"), ABSCISSA), 3: (N_("setpoint centre"), ORDINATE),
               4: (N_("actual length"), ABSCISSA), 5: (N_("actual length"), ORDINATE),
               6: (N_("actual centre"), ABSCISSA), 7: (N_("actual centre"), ORDINATE),
@@ -39,32 +40,32 @@ _RECTANGLE = {0: (N_("setpoint length"), ABSCISSA), 1: (N_("setpoint length"), O
               12: (N_("lower tolerance"), ABSCISSA), 13: (N_("lower tolerance"), ORDINATE),
               16: (N_("difference length"), ABSCISSA), 17: (N_("difference length"), ORDINATE),
               18: (N_("difference centre"), ABSCISSA), 19: (N_("difference centre"), ORDINATE), **_STRATEGY}
-_POINT = {0: (N_("setpoint"),), 1: (N_("setpoint position"), ABSCISSA), 2: (N_("setpoint position"), ORDINATE),
+_POINT: Table = {0: (N_("setpoint"),), 1: (N_("setpoint position"), ABSCISSA), 2: (N_("setpoint position"), ORDINATE),
           3: (N_("setpoint position"), APPLICATE), 4: (N_("actual value"),), 8: (N_("upper tolerance"),),
           12: (N_("lower tolerance"),), 16: (N_("difference"),), **_STRATEGY}
-_ANGLE = {0: (N_("setpoint angle"),), 4: (N_("actual angle"),), 16: (N_("angle difference"),),
+_ANGLE: Table = {0: (N_("setpoint angle"),), 4: (N_("actual angle"),), 16: (N_("angle difference"),),
           20: (N_("angle correction"),), 28: (N_("safe area"),)}
-_CORNER = {4: (N_("angle of the edge (WCS)"),), 5: (N_("corner"), ABSCISSA), 6: (N_("corner"), ORDINATE),
+_CORNER: Table = {4: (N_("angle of the edge (WCS)"),), 5: (N_("corner"), ABSCISSA), 6: (N_("corner"), ORDINATE),
            20: (N_("angle of the edge (MCS)"),), 21: (N_("corner (MCS)"), ABSCISSA),
            22: (N_("corner (MCS)"), ORDINATE)}
 # trigger values per travel direction and their differences (app/nc/cycles/calibration TRIGGER_SLOTS)
-_TRIGGERS: dict[int, tuple[str, ...]] = {}
+_TRIGGERS: Table = {}
 for _i, _axis in enumerate(AOP):
     for _j, _sign in enumerate(("−", "+")):
         _slot = 8 + 4 * _i + 2 * _j
         _TRIGGERS[_slot] = (N_("trigger value %(direction)s"), _axis, _sign)
         _TRIGGERS[_slot + 1] = (N_("difference trigger value %(direction)s"), _axis, _sign)
-_PROBE_CALIBRATION = {**_TRIGGERS, 4: (N_("effective ball diameter"),),
+_PROBE_CALIBRATION: Table = {**_TRIGGERS, 4: (N_("effective ball diameter"),),
                       5: (N_("difference effective ball diameter"),), 6: (N_("centre"), ABSCISSA),
                       7: (N_("centre"), ORDINATE), 20: (N_("position deviation"), "X"),
                       21: (N_("position deviation"), "Y"), 27: (N_("zero offset range"),), 28: (N_("safe area"),)}
-_PROBE_LENGTH = {8: (N_("probe length"),), 9: (N_("difference probe length"),), 27: (N_("zero offset range"),),
+_PROBE_LENGTH: Table = {8: (N_("probe length"),), 9: (N_("difference probe length"),), 27: (N_("zero offset range"),),
                  28: (N_("safe area"),)}
-_TOOL_PROBE = {**_TRIGGERS, 27: (N_("zero offset range"),), 28: (N_("safe area"),)}
-_TOOL = {8: (N_("tool length"),), 9: (N_("difference tool length"),), 10: (N_("tool radius"),),
+_TOOL_PROBE: Table = {**_TRIGGERS, 27: (N_("zero offset range"),), 28: (N_("safe area"),)}
+_TOOL: Table = {8: (N_("tool length"),), 9: (N_("difference tool length"),), 10: (N_("tool radius"),),
          11: (N_("difference tool radius"),), 27: (N_("zero offset range"),), 28: (N_("safe area"),),
          29: (N_("dimension difference"),)}
-_SPHERES: dict[int, tuple[str, ...]] = {0: (N_("setpoint diameter"),), 28: (N_("safe area"),)}
+_SPHERES: Table = {0: (N_("setpoint diameter"),), 28: (N_("safe area"),)}
 for _i, _slot in enumerate(range(1, 4)):
     _SPHERES[_slot] = (N_("setpoint centre"), AOP[_i])
 for _k, (_d, _c, _dd, _cd) in enumerate(((4, 5, 8, 9), (12, 13, 16, 17), (20, 21, 24, 25)), start=1):
@@ -73,7 +74,7 @@ for _k, (_d, _c, _dd, _cd) in enumerate(((4, 5, 8, 9), (12, 13, 16, 17), (20, 21
     for _i in range(3):
         _SPHERES[_c + _i] = (N_("centre sphere %(n)s"), AOP[_i], str(_k))
         _SPHERES[_cd + _i] = (N_("difference centre sphere %(n)s"), AOP[_i], str(_k))
-_KINEMATICS: dict[int, tuple[str, ...]] = {9: (N_("axis offset"),), 10: (N_("direction error (µrad)"),),
+_KINEMATICS: Table = {9: (N_("axis offset"),), 10: (N_("direction error (µrad)"),),
                                            11: (N_("circle residual"),), 12: (N_("sphere diameter"),)}
 for _i, _axis in enumerate("XYZ"):
     _KINEMATICS[_i] = (N_("point on the rotary axis"), _axis)
@@ -81,7 +82,7 @@ for _i, _axis in enumerate("XYZ"):
     _KINEMATICS[6 + _i] = (N_("deviation of the point"), _axis)
 
 
-def ovr_table(cycle: int, variant: int) -> dict[int, tuple[str, ...]]:
+def ovr_table(cycle: int, variant: int) -> Table:
     """The meanings of _OVR for the cycle ``_OVI[2]`` and its variant ``_OVI[3]``."""
     if cycle == 977:
         return _RECTANGLE if variant % 10 in (5, 6) else _SIZE_AND_CENTRE
