@@ -67,34 +67,27 @@ def _surface_variant(call: Call, setval: float) -> tuple[TaskSpec, dict]:
                                  "safe_area": call.length("_TSA")}
 
 
-def cycle976(call: Call) -> None:
+def _task976(call: Call, setval: float) -> tuple[TaskSpec, str, dict[str, object]]:
+    """(task spec, task name, the task's JSON params) of the _MVAR variant."""
     v = call.variant
-    env = call.measuring()
-    before = env.context()
-    if before.probe is None:
-        raise CycleAlarm(alarms.PROBE_TYPE, "the tool in the spindle is not a 3D probe (type 710): load the probe")
-    old = before.probe
-    setval = call.length("_SETVAL")
-    params: dict[str, object]                           # the task's JSON params
-    spec = None
     if v == 0:
         spec, params = _surface_variant(call, setval)
-        task = spec.name
-    elif v == 10000:
+        return spec, spec.name, params
+    if v == 10000:
         if call.integer("_MA") not in (0, 3):
             raise CycleAlarm(alarms.MEASURING_AXIS, "_MVAR=10000 calibrates the length in the applicate: _MA=3")
-        task, params = "probe.length", {"setpoint": {call.plane.infeed: setval}}
-    elif digit(v, 1) in (1, 8) and v < 1_000_000 and digit(v, 2) == 0 and digit(v, 6) == 0 and digit(v, 4) == 0:
+        return TASKS["probe.length"], "probe.length", {"setpoint": {call.plane.infeed: setval}}
+    if digit(v, 1) in (1, 8) and v < 1_000_000 and digit(v, 2) == 0 and digit(v, 6) == 0 and digit(v, 4) == 0:
         if not setval > 0.0:
             raise CycleAlarm(alarms.NC_VALUE_RANGE, f"_SETVAL = {setval:g}: the ring diameter must be > 0")
-        task, params = "probe.radius", {"diameter": setval}
-    else:
-        raise variant_error(call, "supported: 0 (one direction on a surface), 10000 (length on a surface) and "
-                                  "the 4-direction bore variants "
-                                  "(xx0x01, xx0x08; 1 or 2 directions and 'at an angle' are not supported)")
-    params["measurements"] = call.measurements()
-    answer = call.run(env, spec or TASKS[task], params, "measure_only")
-    result = answer.get("result") or {}
+        return TASKS["probe.radius"], "probe.radius", {"diameter": setval}
+    raise variant_error(call, "supported: 0 (one direction on a surface), 10000 (length on a surface) and "
+                              "the 4-direction bore variants "
+                              "(xx0x01, xx0x08; 1 or 2 directions and 'at an angle' are not supported)")
+
+
+def _results976(call: Call, task: str, result: dict, old) -> None:
+    """_OVR of a probe calibration: trigger values, effective diameter, skew, centre, length."""
     probe = result.get("probe") or {}
     new_trigger = {k: float(x) for k, x in (probe.get("trigger") or {}).items()}
     _trigger_results(call, new_trigger, dict(old.trigger))
@@ -112,30 +105,39 @@ def cycle976(call: Call) -> None:
     if task == "probe.length":
         call.ovr[8] = call.out(float(result.get("length", 0.0)))
         call.ovr[9] = call.out(float(result.get("difference", 0.0)))
+
+
+def cycle976(call: Call) -> None:
+    env = call.measuring()
+    before = env.context()
+    if before.probe is None:
+        raise CycleAlarm(alarms.PROBE_TYPE, "the tool in the spindle is not a 3D probe (type 710): load the probe")
+    old = before.probe
+    setval = call.length("_SETVAL")
+    spec, task, params = _task976(call, setval)
+    params["measurements"] = call.measurements()
+    answer = call.run(env, spec, params, "measure_only")
+    _results976(call, task, answer.get("result") or {}, old)
     call.ovr[27] = call.out(call.length("_TZL"))
     call.ovr[28] = call.out(call.length("_TSA"))
 
 
-def cycle971(call: Call) -> None:
-    v = call.variant
-    ma = call.integer("_MA")
-    env = call.measuring()
-    if v in (0, 100000):
-        if ma not in (1, 2, 3, 102, 201):
-            raise CycleAlarm(alarms.MEASURING_AXIS, f"_MA = {ma}: 1, 2, 3, 102 or 201")
-        mode = "length" if ma == 3 and v == 0 else "length_diameter"
-        old = dict((env.context().extra.get("tool_probe") or {}).get("trigger") or {})
-        answer = call.run(env, TASKS["toolprobe.calibrate"], {"mode": mode}, "measure_only")
-        record = (answer.get("result") or {}).get("tool_probe") or {}
-        new = {k: float(x) for k, x in (record.get("trigger") or {}).items()}
-        _trigger_results(call, new, old)
-        call.ovr[27] = call.out(call.length("_TZL"))
-        call.ovr[28] = call.out(call.length("_TSA"))
-        return
-    if v in (10, 11, 12, 10000, 10010, 100010):
-        raise variant_error(call, "workpiece-related (_TPW) and incremental calibrations are not supported")
-    if v not in (1, 2):
-        raise variant_error(call, "CYCLE971: 0 / 100000 calibrate, 1 (stationary) / 2 (rotating) measure")
+def _calibrate971(call: Call, env, ma: int, v: int) -> None:
+    """_MVAR 0 / 100000: calibrate the tool probe (length, or length and diameter)."""
+    if ma not in (1, 2, 3, 102, 201):
+        raise CycleAlarm(alarms.MEASURING_AXIS, f"_MA = {ma}: 1, 2, 3, 102 or 201")
+    mode = "length" if ma == 3 and v == 0 else "length_diameter"
+    old = dict((env.context().extra.get("tool_probe") or {}).get("trigger") or {})
+    answer = call.run(env, TASKS["toolprobe.calibrate"], {"mode": mode}, "measure_only")
+    record = (answer.get("result") or {}).get("tool_probe") or {}
+    new = {k: float(x) for k, x in (record.get("trigger") or {}).items()}
+    _trigger_results(call, new, old)
+    call.ovr[27] = call.out(call.length("_TZL"))
+    call.ovr[28] = call.out(call.length("_TSA"))
+
+
+def _measure971(call: Call, env, ma: int) -> None:
+    """_MVAR 1 / 2: measure the tool's length or radius (stationary / rotating)."""
     if ma not in (1, 2, 3, 103, 203):
         raise CycleAlarm(alarms.MEASURING_AXIS, f"_MA = {ma}: 1/2 radius, 3/103/203 length")
     offset_v = call.length("_ID")
@@ -161,6 +163,20 @@ def cycle971(call: Call) -> None:
     call.ovr[29] = call.out(call.length("_TDIF"))
     call.ovi[0] = 1
     call.ovi[8] = int(tool.get("t") or 0)
+
+
+def cycle971(call: Call) -> None:
+    v = call.variant
+    ma = call.integer("_MA")
+    env = call.measuring()
+    if v in (0, 100000):
+        _calibrate971(call, env, ma, v)
+        return
+    if v in (10, 11, 12, 10000, 10010, 100010):
+        raise variant_error(call, "workpiece-related (_TPW) and incremental calibrations are not supported")
+    if v not in (1, 2):
+        raise variant_error(call, "CYCLE971: 0 / 100000 calibrate, 1 (stationary) / 2 (rotating) measure")
+    _measure971(call, env, ma)
 
 
 def handlers(host) -> dict:

@@ -117,28 +117,62 @@ def three_spheres_finisher(tsa: float, distortion_limit: float):
     return finish
 
 
-def cycle997(call: Call) -> None:
+def _variant997(call: Call) -> tuple[int, bool, bool, bool, bool]:
+    """(109 or 119, at an angle, three spheres, four points, determine the diameter) of _MVAR."""
     v = call.variant
     base = v % 1000
     angle, three, four, determine = (v // 1000) % 10, (v // 10_000) % 10, (v // 100_000) % 10, v // 1_000_000
     if base not in (109, 119) or angle > 1 or three > 1 or four > 1 or determine > 1 or (four and not angle):
         raise variant_error(call, "CYCLE997: 109 / 119 (repeat), +1000 at an angle, +10000 three spheres, "
                                   "+100000 four points (at an angle), +1000000 diameter determination")
+    return base, bool(angle), bool(three), bool(four), bool(determine)
+
+
+def _spheres(call: Call, plane: Plane, setval: float, variant: tuple[int, bool, bool, bool, bool]) -> list[dict]:
+    """The sphere(s) to probe: nominal centres from _SETV (a, o, p), the probing pattern of _MVAR."""
+    base, angle, three, four, determine = variant
+    rf = call.real("_RF")
+    spheres: list[dict[str, Any]] = []
+    for k in range(3 if three else 1):
+        q_aop = np.array([call.length("_SETV", (3 * k + i,)) for i in range(3)])
+        spheres.append({"center": plane.to_xyz(q_aop), "diameter": setval, "angle": angle,
+                        "start_angle": call.real("_STA1"), "increment": call.real("_INCA") or (90.0 if four else 120.0),
+                        "points": 4 if four else 3, "determine": determine, "repeat": base == 119,
+                        "circle_feed": call.ctx.modal.feed_to_mm(rf) if rf > 0.0 else None})
+    return spheres
+
+
+def _write_results997(call: Call, plane: Plane, setval: float, nominal_centre, per_sphere: list[dict],
+                      tsa: float) -> None:
+    """_OVR: [0] _SETVAL, [1..3] the first nominal centre; [4] diameter, [5..7] centre, [8] diameter
+    difference, [9..11] centre differences (sphere 1); sphere 2: [12], [13..15], [16..19]; sphere 3:
+    [20], [21..23], [24..27] (measuring-math §13.2); [28] _TSA."""
+    out = call.out
+    call.ovr[0] = out(setval)
+    for i, value in enumerate(plane.to_aop(nominal_centre)):
+        call.ovr[1 + i] = out(value)
+    layout = ((4, 5, 8, 9), (12, 13, 16, 17), (20, 21, 24, 25))
+    for r, (d_slot, c_slot, dd_slot, cd_slot) in zip(per_sphere, layout, strict=False):
+        centre = plane.to_aop([r["center"][a] for a in AXES])
+        diff = plane.to_aop([r["difference"][a] for a in AXES])
+        call.ovr[d_slot] = out(r["diameter"])
+        call.ovr[dd_slot] = out(r["diameter"] - setval)
+        for i in range(3):
+            call.ovr[c_slot + i] = out(centre[i])
+            call.ovr[cd_slot + i] = out(diff[i])
+    call.ovr[28] = out(tsa)
+
+
+def cycle997(call: Call) -> None:
+    variant = _variant997(call)
+    three = variant[2]
     env = call.measuring()
     setup = env.setup()
     plane = call.plane
     setval = call.length("_SETVAL")
     if not setval > 0.0:
         raise CycleAlarm(alarms.SPHERE_DIAMETER, f"_SETVAL = {call.real('_SETVAL'):g}: the sphere diameter must be > 0")
-    rf = call.real("_RF")
-    n = 3 if three else 1
-    spheres: list[dict[str, Any]] = []
-    for k in range(n):
-        q_aop = np.array([call.length("_SETV", (3 * k + i,)) for i in range(3)])
-        spheres.append({"center": plane.to_xyz(q_aop), "diameter": setval, "angle": bool(angle),
-                        "start_angle": call.real("_STA1"), "increment": call.real("_INCA") or (90.0 if four else 120.0),
-                        "points": 4 if four else 3, "determine": bool(determine), "repeat": base == 119,
-                        "circle_feed": call.ctx.modal.feed_to_mm(rf) if rf > 0.0 else None})
+    spheres = _spheres(call, plane, setval, variant)
     target = call.zo_target(setup)
     tsa = abs(call.length("_TSA"))
     params: dict[str, object]                           # the task's JSON params
@@ -152,23 +186,7 @@ def cycle997(call: Call) -> None:
     params["measurements"] = call.measurements()
     answer = call.run(env, spec, params, target)
     result = answer.get("result") or {}
-    per_sphere = result["spheres"] if three else [result]
-    out = call.out
-    call.ovr[0] = out(setval)
-    for i, value in enumerate(plane.to_aop(spheres[0]["center"])):
-        call.ovr[1 + i] = out(value)
-    # [4] diameter, [5..7] centre, [8] diameter difference, [9..11] centre differences (sphere 1);
-    # sphere 2: [12], [13..15], [16..19]; sphere 3: [20], [21..23], [24..27] (measuring-math §13.2)
-    layout = ((4, 5, 8, 9), (12, 13, 16, 17), (20, 21, 24, 25))
-    for r, (d_slot, c_slot, dd_slot, cd_slot) in zip(per_sphere, layout, strict=False):
-        centre = plane.to_aop([r["center"][a] for a in AXES])
-        diff = plane.to_aop([r["difference"][a] for a in AXES])
-        call.ovr[d_slot] = out(r["diameter"])
-        call.ovr[dd_slot] = out(r["diameter"] - setval)
-        for i in range(3):
-            call.ovr[c_slot + i] = out(centre[i])
-            call.ovr[cd_slot + i] = out(diff[i])
-    call.ovr[28] = out(tsa)
+    _write_results997(call, plane, setval, spheres[0]["center"], result["spheres"] if three else [result], tsa)
     correction = answer.get("correction") or {}
     call.ovi[11] = 1 if correction.get("after") is not None and target != MEASURE_ONLY else 0
     if three:
