@@ -63,16 +63,18 @@ _SETVAL = _real("_SETVAL", N_("Setpoint"))
 _AXIS = _int("_MA", N_("Measuring axis"), 1, 1, 3)
 _KNUM = _int("_KNUM", N_("Correction target (zero offset or tool offset)"), 0, 0, 9999999)
 _INFEED = _real("_ID", N_("Infeed / offset"))
+# touches on the circle (this HMI's extension, app.nc.cycles.workpiece.circle_points; 0: the manual's)
+_NPTS = _int("_NPTS", N_("Number of points"), 0, 0, 36)
 
 CYCLES: dict[str, tuple[CycleField, ...]] = {
     "CYCLE976": (_VARIANT, _SETVAL, _AXIS, _int("_MD", N_("Measuring direction (0 +, 1 −)"), 1, 0, 1),
                  *_COMMON, _real("_TZL", N_("Zero offset range"), 0.0, 0.0, 1e5)),
     "CYCLE977": (_VARIANT, _SETVAL, _real("_SETV[0]", N_("Setpoint length")), _real("_SETV[1]", N_("Setpoint width")),
-                 _AXIS, _INFEED, _KNUM, *_COMMON, *_TOOL_OFFSET),
+                 _AXIS, _INFEED, _KNUM, _NPTS, *_COMMON, *_TOOL_OFFSET),
     "CYCLE978": (_VARIANT, _SETVAL, _AXIS, _KNUM, *_COMMON, *_TOOL_OFFSET),
     "CYCLE979": (_VARIANT, _SETVAL, _real("_CPA", N_("Centre point, abscissa")),
                  _real("_CPO", N_("Centre point, ordinate")), _real("_STA1", N_("Starting angle")),
-                 _real("_INCA", N_("Indexing angle")), _KNUM, *_COMMON, *_TOOL_OFFSET),
+                 _real("_INCA", N_("Indexing angle")), _KNUM, _NPTS, *_COMMON, *_TOOL_OFFSET),
     "CYCLE998": (_VARIANT, _SETVAL, _real("_SETV[0]", N_("Setpoint of the second angle")), _AXIS, _INFEED,
                  _real("_STA1", N_("Starting angle")), _real("_RA", N_("Rotary axis correction")), _KNUM, *_COMMON),
     "CYCLE961": (_VARIANT, _real("_SETV[0]", N_("Setpoint length")), _real("_SETV[1]", N_("Setpoint width")),

@@ -107,3 +107,13 @@ def test_a_wrong_npts_is_refused_before_anything_moves(client, words, names):
     assert list(nc.ball_mcs()) == list(before)
     nc.ok(nc.c.post("/api/nc/reset"))
     nc.mda("_NPTS=0")
+
+
+def test_the_editor_writes_and_reads_back_npts():
+    """The cycle support's form (design.md §10.2) offers _NPTS for CYCLE977 and CYCLE979."""
+    from app.nc.cycle_forms import CYCLES, read, render
+
+    for cycle in ("CYCLE977", "CYCLE979"):
+        assert "_NPTS" in [f.name for f in CYCLES[cycle]]
+        params = {"_MVAR": 1, "_SETVAL": 12.0, "_NPTS": 8}
+        assert read(render(cycle, params)) == (cycle, params)
