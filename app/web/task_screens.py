@@ -19,7 +19,7 @@ from app.access.deps import denied, measuring_function, needs, require_measureme
 from app.errors import WorkflowError
 from app.i18n import N_, _, language
 from app.services.measuring import MeasuringEnv
-from app.workflow import planning
+from app.workflow import guard, planning
 from app.workflow.executor import StepExecutor
 from app.workflow.forms import TOOL_TARGET, FieldSpec, FormEnv
 from app.workflow.tasks import Category, task_spec
@@ -321,6 +321,7 @@ def _svgs(env: _Env, task: str, params: dict | None, session, answer: dict | Non
     except Exception:       # a bug: logged, and shown in the picture's place
         return [picture_failed("the measuring preview")]
     steps = []
+    refused = None
     result = (answer or {}).get("result")
     if params is not None and not result:
         n = (session.next_point() if session is not None else None) or 1
@@ -331,10 +332,17 @@ def _svgs(env: _Env, task: str, params: dict | None, session, answer: dict | Non
             steps = []
         except Exception:
             return [picture_failed("the planned path")]
+        if steps and guard.guarded(spec) and spec.coords == "WCS" and (session is None or session.guard):
+            try:            # the start guard's verdict: the segment NC Start would refuse is marked
+                refused = guard.check_point(env.machine.machine, spec, normalised, n, ctx)[0].refusal
+            except EXPECTED:
+                refused = None
+            except Exception:
+                return [picture_failed("the start guard's check")]
     points = session.to_api()["points"] if session is not None else []
     radius = ctx.probe.ball_diameter / 2.0 if ctx.probe else float((ctx.tool or {}).get("radius") or 1.0)
     return draw(task, ctx.plane, params=params, start=start, steps=steps, points=points, result=result,
-                ball_radius=radius)
+                ball_radius=radius, refused=refused)
 
 
 def _screen_context(env: _Env, page: TaskPage, form: dict | None, *, answer=None, alarm=None, errors=None,

@@ -32,6 +32,7 @@ class View:
     shapes: list[str] = field(default_factory=list)
     points: list[tuple[float, float]] = field(default_factory=list)   # for the bounding box
     caption: str = ""                                                  # result text beside the title
+    refused: str = ""          # the start guard's refused step ("P1 DZ"), marked in the picture
 
     def uv(self, p: dict | np.ndarray) -> tuple[float, float]:
         if isinstance(p, dict):
@@ -79,10 +80,11 @@ class View:
         scale = max(x1 - x0, y1 - y0) / 300.0
         style = f"--s:{scale:.4f}"
         body = "".join(self.shapes)
+        refused = f' data-guard-refused="{escape(self.refused)}"' if self.refused else ""
         return Markup(
             f'<figure class="task-view"><figcaption>{escape(title)}'
             f'{" · " if self.caption else ""}<b class="result">{escape(self.caption)}</b></figcaption>'
-            f'<svg id="task-svg-{self.name}" class="task-svg" viewBox="{x0:.3f} {y0:.3f} {x1 - x0:.3f} {y1 - y0:.3f}" '
+            f'<svg id="task-svg-{self.name}" class="task-svg"{refused} viewBox="{x0:.3f} {y0:.3f} {x1 - x0:.3f} {y1 - y0:.3f}" '
             f'preserveAspectRatio="xMidYMid meet" role="img" aria-label="{escape(title)}" style="{style}" '
             f'font-size="{14 * scale:.3f}" stroke-width="{1.2 * scale:.4f}">'
             f'<g class="axes-cross">{self._cross(x0, x1, y0, y1)}</g>{body}</svg></figure>')
@@ -106,8 +108,10 @@ def needs_side_view(task: str, params: dict | None) -> bool:
 
 
 def draw(task: str, plane: Plane, *, params: dict | None = None, start=None, steps=(), points=(),
-         result: dict | None = None, ball_radius: float = 2.0) -> list[Markup]:
-    """SVG figures for the screen. ``points``: stored-point dicts (``PointSlot.to_api``)."""
+         result: dict | None = None, ball_radius: float = 2.0, refused=None) -> list[Markup]:
+    """SVG figures for the screen. ``points``: stored-point dicts (``PointSlot.to_api``);
+    ``refused``: the start guard's refused segment (``engine.guard.Segment``, plan coordinates),
+    drawn over the path with where it would hit (issue 24 §1)."""
     views = [View("top", plane.first, plane.second)]
     if needs_side_view(task, params) or _steps_leave_plane(steps, plane):
         views.append(View("side", plane.first, plane.infeed))
@@ -118,6 +122,8 @@ def draw(task: str, plane: Plane, *, params: dict | None = None, start=None, ste
             _result(view, task, result, plane)
             continue
         _path(view, start, steps)
+        if refused is not None:
+            _refused(view, refused, ball_radius)
         _stored(view, points)
         if start is not None:
             view.circle(view.uv(start), ball_radius, "ball")
@@ -152,6 +158,17 @@ def _path(view: View, start, steps) -> None:
             view.line(view.uv(pos), view.uv(end), "probe-move")
             view.circle(view.uv(end), 0.6, "contact")
             pos = end
+
+
+def _refused(view: View, seg, ball_radius: float) -> None:
+    """The segment the start guard refuses: from its start to where the ball would touch (or its
+    end), the ball there, and its step's name."""
+    hit = seg.where if seg.where is not None else seg.end
+    a, b = view.uv(np.asarray(seg.start, dtype=float)), view.uv(np.asarray(hit, dtype=float))
+    view.line(a, b, "guard-refused")
+    view.circle(b, ball_radius, "guard-hit")
+    view.text((b[0] + ball_radius + 1, b[1] + ball_radius + 1), f"✕ {seg.label}", "label guard-label")
+    view.refused = seg.label or str(seg.index)
 
 
 def _stored(view: View, points) -> None:

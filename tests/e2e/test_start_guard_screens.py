@@ -50,3 +50,22 @@ def test_nc_start_on_the_screen_says_why_nothing_moved(page, api):
     expect(page.locator("body")).to_contain_text("65300", timeout=5000)
     state = api.get("/api/machine").json()
     assert state["mcs"] == before and not state["busy"] and not state["alarms"]
+
+
+def test_the_measuring_screens_picture_marks_the_refused_segment(page, api):
+    before = into_the_hole(api)
+    page.goto("/measure/workpiece/pocket/hole1")
+    expect(page.locator("#task-form")).to_be_visible()
+    target = page.locator('#task-form select[name="target"]')
+    if target.count():
+        target.select_option("measure_only")
+    field = page.locator('#task-form [name="diameter"]')
+    field.fill("130")
+    field.press("Tab")
+    top = page.locator("#task-svg-top")
+    expect(top).to_have_attribute("data-guard-refused", re.compile(r"^P1"), timeout=5000)
+    expect(top.locator(".guard-refused")).to_have_count(1)
+    field.fill("20")
+    field.press("Tab")
+    expect(page.locator("#task-svg-top .guard-refused")).to_have_count(0, timeout=5000)
+    assert api.get("/api/machine").json()["mcs"] == before

@@ -10,6 +10,8 @@ scenario defaults), permissible deflection 5 mm; the block's top face is part z 
 
 from __future__ import annotations
 
+import re
+
 import pytest
 import test_start_guard as guarded
 from truthkit import Operator
@@ -120,3 +122,28 @@ def test_tool_measuring_says_it_is_not_checked_for_collisions(tool_api):
     # the milling machine's tool probe is not broken by overtravel: its reach is not checked
     probes = [s for s in plan["segments"] if s["kind"] == "probe"]
     assert probes and all(s["braking"] is None for s in probes)
+
+
+# --- the measuring screen's 2D preview marks the refused segment ------------------------------------
+
+HTMX = {"HX-Request": "true"}
+
+
+def test_the_measuring_screens_preview_marks_the_refused_segment(op):
+    """The deep spigot of the issue (Ø20, 12 high, infeed 30 from 10 above its top): the live
+    picture marks P1's down move in red with the ball where it would touch; a fitting infeed
+    marks nothing. The picture only reads: the axes stay where they are."""
+    op.ball_to_part(guarded.SPIGOT_C[0], guarded.SPIGOT_C[1], guarded.SPIGOT_H + R + 10.0)
+    before = op.ok(op.c.get("/api/machine"))["mcs"]
+    form = {"diameter": "20", "infeed": "30", "target": "measure_only"}
+    text = op.c.post("/measure/task/spigot.1/svg", data=form, headers=HTMX).text
+    assert 'class="guard-refused"' in text and 'class="guard-hit"' in text, text
+    marked = re.search(r'id="task-svg-side" class="task-svg" data-guard-refused="([^"]+)"', text)
+    assert marked is not None and marked.group(1).startswith("P1") and "DZ" in marked.group(1)
+    # the side view: the ball would touch the block's top face (part z = 0) with its centre R above it
+    hit = re.search(r'<svg id="task-svg-side".*?<circle class="guard-hit" cx="([-\d.]+)" cy="([-\d.]+)"', text, re.S)
+    assert hit is not None and -float(hit.group(2)) == pytest.approx(R, abs=1e-3)
+    fits = op.c.post("/measure/task/spigot.1/svg", data={**form, "infeed": str(guarded.SPIGOT_H / 2 + R + 10.0)},
+                     headers=HTMX).text
+    assert "guard-refused" not in fits and "task-svg-side" in fits
+    assert op.ok(op.c.get("/api/machine"))["mcs"] == before
