@@ -5,14 +5,14 @@ word, before anything moves), never with a bare "unknown name" (issue 28 item 1)
 
 from __future__ import annotations
 
-_LATHE = ("a measuring cycle of the lathe (manual ch. 6); this channel is the milling machine's: "
-          "measure on the lathe with the lathe tasks of the JOG screens")
+_LATHE = ("a measuring cycle of the lathe (manual ch. 6) that this control's NC does not run (on the milling "
+          "machine and on the lathe alike): measure on the lathe with the lathe tasks of the JOG screens")
 
 OUT_OF_SCOPE: dict[str, tuple[str, str]] = {
-    "DIAMON": ("§6", "diameter programming of the lathe (manual ch. 6); this channel is the milling "
-                     "machine's, where X is a radius coordinate"),
-    "DIAMOF": ("§6", "diameter programming off (lathe, manual ch. 6); this channel is the milling "
-                     "machine's, where X is always a radius coordinate"),
+    "DIAMON": ("§6", "diameter programming of the lathe (manual ch. 6) is not part of this control's NC: "
+                     "programs give X as a radius coordinate, on the lathe too"),
+    "DIAMOF": ("§6", "diameter programming off (lathe, manual ch. 6) is not part of this control's NC: "
+                     "programs always give X as a radius coordinate, on the lathe too"),
     "CYCLE982": ("§6.2–6.3", f"tool measuring on the lathe is {_LATHE}"),
     "CYCLE973": ("§6.4", f"calibrating the workpiece probe on the lathe is {_LATHE}"),
     "CYCLE974": ("§6.5", f"1-point measuring on the lathe is {_LATHE}"),

@@ -86,3 +86,26 @@ def test_the_chinese_cycle_name_is_refused_as_printed():
 
 def test_the_fullwidth_semicolon_of_chapter_6_starts_a_comment():
     load("N10 G0 X10 ；车刀T3当前有效\nN20 M2 ；程序结束")
+
+
+@pytest.mark.parametrize("first", [16812, 19596, 21272, 22051])
+def test_on_the_lathe_a_chapter_6_listing_is_refused_by_name_and_nothing_moves(client, first):
+    """On the lathe too (scenario kind "lathe") the NC names the word and the section, with alarm
+    12550, through the API (422, never a bare syntax error), before anything moves."""
+    import json
+    from pathlib import Path
+
+    scen = json.loads((Path(__file__).resolve().parents[2] / "app" / "machine" / "lathe_demo_scenario.json")
+                      .read_text(encoding="utf-8"))
+    scen["machine"]["time_scale"] = 0
+    assert client.post("/api/sim/scenario", json={**scen, "reset_data": True}).status_code == 200
+    machine = client.get("/api/machine").json()
+    assert machine["kind"] == "lathe"
+    listing = next(item for item in ALL if item.lines[0] == first)
+    answer = client.post("/api/nc/run", json={"mda": as_read(listing)})
+    assert answer.status_code == 422, answer.text
+    error = answer.json()["error"]
+    assert error["code"] == "nc_syntax" and error["alarm"]["code"] == 12550
+    assert error["message"].startswith(f"{REFUSED[first]} (manual §6"), error["message"]
+    assert "milling machine's" not in error["message"]
+    assert client.get("/api/machine").json()["mcs"] == machine["mcs"]
