@@ -10,6 +10,7 @@ the ball centre (fits use it), the surface point is the same either way.
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -29,12 +30,13 @@ _PARALLEL_TOL = 1e-9
 
 def parallel_axis(direction_wcs: npt.ArrayLike) -> tuple[int, float] | None:
     """(axis index j, sign σ) when ``direction_wcs`` is axis-parallel within 1e-9, else None."""
-    d = checks.unit_vector(direction_wcs, dim=3)
-    j = int(np.argmax(np.abs(d)))
-    others = np.delete(d, j)
-    if float(np.linalg.norm(others)) > _PARALLEL_TOL:
+    x, y, z = checks.unit_vector(direction_wcs, dim=3).tolist()
+    ax, ay, az = abs(x), abs(y), abs(z)
+    j = 0 if ax >= ay and ax >= az else (1 if ay >= az else 2)     # np.argmax: the first largest
+    o1, o2 = (y, z) if j == 0 else ((x, z) if j == 1 else (x, y))
+    if math.sqrt(o1 * o1 + o2 * o2) > _PARALLEL_TOL:
         return None
-    return j, (1.0 if d[j] > 0 else -1.0)
+    return j, (1.0 if (x, y, z)[j] > 0 else -1.0)
 
 
 def trigger_key(j: int, sign: float) -> str:

@@ -22,7 +22,16 @@ from app.i18n import N_
 from app.machine.protocol import ProbeReach, ProtectedSpace
 from app.workflow.executor import StepExecutor
 from engine import alarms
-from engine.guard import Braking, GuardReport, Placement, Segment, check_program, probe_reach, segments_to_api
+from engine.guard import (
+    Braking,
+    GuardReport,
+    Placement,
+    ProtectionModel,
+    Segment,
+    check_program,
+    probe_reach,
+    segments_to_api,
+)
 from engine.guard_model import braking_from_data, model_from_data
 from engine.plan import ideal_path
 from engine.plan_workpiece import ball_offset
@@ -91,7 +100,22 @@ def check_point(machine, spec, params: dict, n: int, ctx) -> tuple[GuardReport, 
                           ball_shift=np.asarray(wcs2bcs.child2parent(ball_offset(plan_ctx)), dtype=float),
                           axes_shift=np.asarray(tip.axes_for_tip(np.zeros(3), "WCS"), dtype=float),
                           ball_radius=float(plan_ctx.probe.ball_diameter) / 2.0)
-    return check_program(program, start, model_from_data(protection_data(machine)), placement, braking), coords
+    return check_program(program, start, _model_of(protection_data(machine)), placement, braking), coords
+
+
+_model_cache: tuple[dict | None, ProtectionModel] | None = None
+
+
+def _model_of(data: dict | None) -> ProtectionModel:
+    """``model_from_data``, built again only when the data differ from the last (the work space
+    changes with a scenario or a rotary table turn, not with every NC Start)."""
+    global _model_cache
+    cached = _model_cache
+    if cached is not None and cached[0] == data:
+        return cached[1]
+    model = model_from_data(data)
+    _model_cache = (data, model)
+    return model
 
 
 def _unknown(steps, start, braking: Braking | None = None) -> GuardReport:
