@@ -175,33 +175,10 @@ class Call:
     def zo_target(self, setup: MeasuringSetup) -> str:
         """_KNUM as a zero offset (measuring-math §2.1)."""
         knum = self.integer("_KNUM")
-        names = setup.offset_names
-        basic = [n for n in names if n.startswith("BASIC_") and n != "BASIC_REF"]
         if knum == 0:
             return MEASURE_ONLY
-        if 1 <= knum <= 4:
-            name = f"G{53 + knum}"
-        elif 5 <= knum <= 99:
-            name = f"G{500 + knum}"
-        elif knum == 1000:
-            if not basic:
-                raise CycleAlarm(alarms.BASIC_FRAME_MISSING, "_KNUM=1000: the channel has no basic frame")
-            name = basic[-1]
-        elif 1011 <= knum <= 1026:
-            name = f"BASIC_{knum - 1011}"
-        elif knum == 2000:
-            name = "BASIC_REF"
-        elif knum == 9999:
-            active = setup.active_offset
-            if active == "G500":
-                if not basic:
-                    raise CycleAlarm(alarms.BASIC_FRAME_MISSING, "_KNUM=9999 with G500: the channel has no basic frame")
-                name = basic[-1]
-            else:
-                name = active
-        else:
-            raise CycleAlarm(alarms.ZO_NUMBER, f"_KNUM={knum}: not a zero offset of this control "
-                             "(1..99 G54.., 1000, 1011..1026 basic frames, 2000 system frame, 9999 active)")
+        names = setup.offset_names
+        name = _zo_name(knum, setup.active_offset, [n for n in names if n.startswith("BASIC_") and n != "BASIC_REF"])
         if name not in names:
             definition = alarms.BASIC_FRAME_MISSING if is_basic(name) else alarms.ZO_NUMBER
             raise CycleAlarm(definition, f"_KNUM={knum}: {name} is not configured")
@@ -216,37 +193,7 @@ class Call:
         knum = self.integer("_KNUM")
         if knum == 0:
             return MEASURE_ONLY
-        if knum < 0 or knum > 9_999_999:
-            raise CycleAlarm(alarms.KNUM_DIGIT7, f"_KNUM={knum}: not a tool offset code")
-        d = knum % 1000
-        kind, inverse, which, dl = digit(knum, 4), digit(knum, 5), digit(knum, 6), knum // 1_000_000
-        if d == 0:
-            raise CycleAlarm(alarms.D_NUMBER, f"_KNUM={knum}: D number 0")
-        if d != 1:
-            raise CycleAlarm(alarms.D_NUMBER_TOO_HIGH, f"_KNUM={knum}: D{d}: the tool table holds D1 only")
-        if kind not in (0, 1, 2):
-            raise CycleAlarm(alarms.KNUM_DIGIT4, f"_KNUM={knum}: 4th digit must be 0, 1 or 2")
-        if inverse not in (0, 1):
-            raise CycleAlarm(alarms.KNUM_DIGIT5, f"_KNUM={knum}: 5th digit must be 0 or 1")
-        if inverse:
-            raise CycleAlarm(alarms.KNUM_DIGIT5, f"_KNUM={knum}: the inverse correction (5th digit 1) is not "
-                             "supported")
-        if which not in (0, 1, 4) and which not in (2, 3):
-            raise CycleAlarm(alarms.KNUM_DIGIT6, f"_KNUM={knum}: 6th digit must be 0..4")
-        if which in (2, 3):
-            raise CycleAlarm(alarms.KNUM_DIGIT6, f"_KNUM={knum}: L2/L3 are not in the tool table (L1 and R only)")
-        if dl:
-            raise CycleAlarm(alarms.KNUM_DIGIT7, f"_KNUM={knum}: setup/sum offsets and tool environments "
-                             "(7th digit) are not supported")
-        if which == 1:
-            correct = "length"
-        elif which == 4 or kind == 2:
-            correct = "radius"
-        elif correct_length:
-            correct = "length"
-        else:
-            raise CycleAlarm(alarms.KNUM_DIGIT4, f"_KNUM={knum}: the length in the measuring axis is L1 only "
-                             "when measuring in the applicate")
+        d, correct = _tool_knum(knum, correct_length)
         t = self.integer("_TNUM")
         if t <= 0:
             raise CycleAlarm(alarms.TOOL_NUMBER, f"_KNUM={knum}: no tool for the correction: set _TNUM")
@@ -290,12 +237,7 @@ class Call:
         except WorkflowError as exc:
             raise self.alarm_of(exc, session) from None
         except HmiError as exc:          # access level, storage, correction out of range, ...
-            if exc.code == "guard":      # the start guard refused the path: nothing moved (issue 24 §1)
-                code = int((exc.extra.get("alarm") or {}).get("code") or 0)
-                raise CycleAlarm(alarms.by_number(code) or alarms.START_GUARD_COLLISION, exc.message) from None
-            definition = alarms.NC_WRITE_PROTECTED if exc.code in ("access_level", "unauthenticated") \
-                else alarms.NC_VALUE_RANGE
-            raise CycleAlarm(definition, exc.message) from None
+            raise _cycle_alarm_of(exc) from None
 
     def _warn_probe(self, warnings: Sequence[str]) -> None:
         """A warning of the measurement that names an alarm (an uncalibrated or invalid probe,
@@ -355,6 +297,76 @@ class Call:
             v.set("_OVR", float(self.ovr.get(i, 0.0)), (i,))
         for i in range(14):
             v.set("_OVI", int(self.ovi.get(i, 0)), (i,))
+
+
+def _cycle_alarm_of(exc: HmiError) -> CycleAlarm:
+    """The cycle alarm of a refusal of the HMI (access level, storage, correction out of range, ...)."""
+    if exc.code == "guard":      # the start guard refused the path: nothing moved (issue 24 §1)
+        code = int((exc.extra.get("alarm") or {}).get("code") or 0)
+        return CycleAlarm(alarms.by_number(code) or alarms.START_GUARD_COLLISION, exc.message)
+    definition = alarms.NC_WRITE_PROTECTED if exc.code in ("access_level", "unauthenticated") \
+        else alarms.NC_VALUE_RANGE
+    return CycleAlarm(definition, exc.message)
+
+
+def _zo_name(knum: int, active: str, basic: list[str]) -> str:
+    """The zero offset _KNUM (not 0) names: 1..4 G54..G57, 5..99 G505.., 1000 the last basic frame,
+    1011..1026 BASIC_0.., 2000 the system frame, 9999 the active one (G500: the last basic frame)."""
+    if 1 <= knum <= 4:
+        return f"G{53 + knum}"
+    if 5 <= knum <= 99:
+        return f"G{500 + knum}"
+    if knum == 1000 or knum == 9999 and active == "G500":
+        if not basic:
+            which = "_KNUM=1000" if knum == 1000 else "_KNUM=9999 with G500"
+            raise CycleAlarm(alarms.BASIC_FRAME_MISSING, f"{which}: the channel has no basic frame")
+        return basic[-1]
+    if 1011 <= knum <= 1026:
+        return f"BASIC_{knum - 1011}"
+    if knum == 2000:
+        return "BASIC_REF"
+    if knum == 9999:
+        return active
+    raise CycleAlarm(alarms.ZO_NUMBER, f"_KNUM={knum}: not a zero offset of this control "
+                     "(1..99 G54.., 1000, 1011..1026 basic frames, 2000 system frame, 9999 active)")
+
+
+def _tool_knum(knum: int, correct_length: bool | None) -> tuple[int, str]:
+    """(D number, "length" or "radius") of a tool-offset _KNUM (not 0), its digits checked."""
+    d, kind, which = _tool_knum_digits(knum)
+    if which == 1 or which == 0 and kind in (0, 1) and correct_length:
+        return d, "length"
+    if which == 4 or kind == 2:
+        return d, "radius"
+    raise CycleAlarm(alarms.KNUM_DIGIT4, f"_KNUM={knum}: the length in the measuring axis is L1 only "
+                     "when measuring in the applicate")
+
+
+def _tool_knum_digits(knum: int) -> tuple[int, int, int]:
+    """(D number, digit 4, digit 6) of a tool-offset _KNUM, each digit checked (manual §2.3)."""
+    if knum < 0 or knum > 9_999_999:
+        raise CycleAlarm(alarms.KNUM_DIGIT7, f"_KNUM={knum}: not a tool offset code")
+    d = knum % 1000
+    kind, inverse, which, dl = digit(knum, 4), digit(knum, 5), digit(knum, 6), knum // 1_000_000
+    if d == 0:
+        raise CycleAlarm(alarms.D_NUMBER, f"_KNUM={knum}: D number 0")
+    if d != 1:
+        raise CycleAlarm(alarms.D_NUMBER_TOO_HIGH, f"_KNUM={knum}: D{d}: the tool table holds D1 only")
+    if kind not in (0, 1, 2):
+        raise CycleAlarm(alarms.KNUM_DIGIT4, f"_KNUM={knum}: 4th digit must be 0, 1 or 2")
+    if inverse not in (0, 1):
+        raise CycleAlarm(alarms.KNUM_DIGIT5, f"_KNUM={knum}: 5th digit must be 0 or 1")
+    if inverse:
+        raise CycleAlarm(alarms.KNUM_DIGIT5, f"_KNUM={knum}: the inverse correction (5th digit 1) is not "
+                         "supported")
+    if which not in (0, 1, 4) and which not in (2, 3):
+        raise CycleAlarm(alarms.KNUM_DIGIT6, f"_KNUM={knum}: 6th digit must be 0..4")
+    if which in (2, 3):
+        raise CycleAlarm(alarms.KNUM_DIGIT6, f"_KNUM={knum}: L2/L3 are not in the tool table (L1 and R only)")
+    if dl:
+        raise CycleAlarm(alarms.KNUM_DIGIT7, f"_KNUM={knum}: setup/sum offsets and tool environments "
+                         "(7th digit) are not supported")
+    return d, kind, which
 
 
 def describe_target(target) -> str:

@@ -24,7 +24,9 @@ from engine import alarms
 AXES = {1: "A", 2: "B", 3: "C"}
 
 
-def cycle996(call: Call) -> None:
+def _params996(call: Call) -> dict:
+    """The kinematics task's params from the cycle's: _MA axis, _SETVAL sphere Ø, _SETV[0..2] its
+    centre, _SETV[3] positions from _STA1 in steps of _INCA, _MVAR check (0) or optimise (1)."""
     mode = call.variant
     if mode not in (0, 1):
         raise variant_error(call, "CYCLE996: _MVAR 0 (check) or 1 (optimise)")
@@ -38,12 +40,17 @@ def cycle996(call: Call) -> None:
     if not 3 <= count <= 36:
         raise CycleAlarm(alarms.NC_VALUE_RANGE, f"_SETV[3] = {call.real('_SETV', (3,)):g}: 3..36 positions")
     start, step = call.real("_STA1"), call.real("_INCA")
-    params = {"sphere": {"center": [call.length("_SETV", (i,)) for i in range(3)], "diameter": diameter},
-              "axis": axis, "positions": [start + k * step for k in range(count)],
-              "mode": "optimise" if mode == 1 else "check", "clearance": max(0.5, min(50.0, call.fa))}
+    return {"sphere": {"center": [call.length("_SETV", (i,)) for i in range(3)], "diameter": diameter},
+            "axis": axis, "positions": [start + k * step for k in range(count)],
+            "mode": "optimise" if mode == 1 else "check", "clearance": max(0.5, min(50.0, call.fa))}
+
+
+def cycle996(call: Call) -> None:
+    params = _params996(call)
+    axis = params["axis"]
     env = call.measuring()
     facts = env.context().extra.get("kinematics") or {}
-    points = count + (1 if partner_of(params, facts) is not None else 0)     # + the zero-position reference
+    points = len(params["positions"]) + (1 if partner_of(params, facts) is not None else 0)  # + the zero reference
     answer = call.run(env, KINEMATICS_SPEC, params, "measure_only", order=range(1, points + 1))
     result = answer.get("result") or {}
     line = (result.get("axes") or {}).get(axis) or {}

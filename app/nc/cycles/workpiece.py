@@ -126,7 +126,8 @@ _977_TASKS = {1: "hole.1", 2: "spigot.1", 3: "edge.distance", 4: "edge.distance"
               6: "spigot.rect"}
 
 
-def cycle977(call: Call) -> None:
+def _variant977(call: Call) -> tuple[int, int]:
+    """(kind 1..6, ZO digit) of _MVAR; the protection-zone variants are refused."""
     v = call.variant
     kind, zo, zone = v % 10, digit_at(v, 3), digit_at(v, 4)
     if v not in {k + 100 * z for k in range(1, 7) for z in (0, 1)} | {k + 100 * z + 1000 for k in range(1, 7)
@@ -135,22 +136,15 @@ def cycle977(call: Call) -> None:
                                   "(+100 ZO, +1000 protection zone)")
     if zone:
         raise variant_error(call, "protection zone variants (1xxx) are not supported")
-    env = call.measuring()
-    setup = env.setup()
-    plane = call.plane
-    a, o = plane.first, plane.second
-    start = call.position()
-    sa, so, sp = (float(x) for x in plane.to_aop(start))
-    setval = call.length("_SETVAL")
-    target = call.zo_target(setup) if zo else call.tool_target()
-    tool = isinstance(target, dict)
-    spec = TASKS[_977_TASKS[kind]]
-    params: dict = {"setpoint": {a: sa, o: so}, "measurements": call.measurements()}
-    _with_points(call, kind, params)
-    before_point = None
-    axis = None
+    return kind, zo
+
+
+def _params977(call: Call, env, kind: int, params: dict, start: np.ndarray, setval: float):
+    """The task's params of ``kind`` (filled into ``params``): (the tolerances' setpoint, the move
+    before each point or None)."""
     if kind in (1, 2, 3, 4) and not setval > 0.0:
         raise CycleAlarm(alarms.NC_VALUE_RANGE, f"_SETVAL = {setval:g}: the diameter/width must be > 0")
+    infeed = 0.0
     if kind in (2, 4, 6):
         infeed = -call.length("_ID")
         if not infeed > 0.0:
@@ -160,54 +154,54 @@ def cycle977(call: Call) -> None:
         params["diameter"] = setval
         if kind == 2:
             params["infeed"] = infeed
-        tol_setpoint = setval
-    elif kind in (3, 4):
-        ma = call.integer("_MA")
-        if ma not in (1, 2):
-            raise CycleAlarm(alarms.MEASURING_AXIS, f"_MA = {ma}: slot and web are measured along the abscissa (1) "
-                             "or the ordinate (2)")
-        axis = plane.axes[ma - 1]
-        u = plane.unit(axis)
-        params.update({"axis": axis, "direction": "+", "direction_p2": "-",
-                       "setpoint": {axis: float(start @ u)}})
-        tol_setpoint = setval
-        probe = _probe(env)
-        fa, feed = call.fa, _position_feed(env)
-        if kind == 3:
-            def before_point(n, u=u):
-                d = u if n == 1 else -u
-                reach = max(0.0, setval / 2.0 - trigger_radius(probe, d, plane) - fa)
-                call.move(start + reach * d, feed)
-        else:
-            low = start - infeed * plane.infeed_unit
-            side = setval / 2.0 + effective_radius(probe) + fa
+        return setval, None
+    if kind in (3, 4):
+        return setval, _slot_or_web977(call, env, kind, params, start, setval, infeed)
+    length, width = call.length("_SETV", (0,)), call.length("_SETV", (1,))
+    if not (length > 0.0 and width > 0.0):
+        raise CycleAlarm(alarms.NC_VALUE_RANGE, "_SETV[0], _SETV[1]: the rectangle's lengths must be > 0")
+    params.update({"length": length, "width": width})
+    if kind == 6:
+        params["infeed"] = infeed
+    return 0.0, None            # the JOG strategy compares the mean length difference (measuring-math §8.3 [I])
 
-            def before_point(n, u=u):
-                here = call.position()
-                call.move(here + (float((start - here) @ plane.infeed_unit)) * plane.infeed_unit, feed)
-                over = start + (-side if n == 1 else side) * u
-                call.move(over, feed)
-                call.move(over + (low - start), feed)
-    else:
-        length, width = call.length("_SETV", (0,)), call.length("_SETV", (1,))
-        if not (length > 0.0 and width > 0.0):
-            raise CycleAlarm(alarms.NC_VALUE_RANGE, "_SETV[0], _SETV[1]: the rectangle's lengths must be > 0")
-        params.update({"length": length, "width": width})
-        if kind == 6:
-            params["infeed"] = infeed
-        tol_setpoint = 0.0            # the JOG strategy compares the mean length difference (measuring-math §8.3 [I])
-    if tool:
-        params["tolerance"] = call.tolerance(tol_setpoint)
-    elif zo:
-        def differences(result):
-            centre = result.get("center") or {}
-            return [centre.get(k, s) - s for k, s in params["setpoint"].items()]
-        spec = with_finisher(spec, _check_safe_area(call, differences))
-    answer = call.run(env, spec, params, target, before_point=before_point)
-    if kind == 4:                                  # web: back up over the centre
+
+def _slot_or_web977(call: Call, env, kind: int, params: dict, start: np.ndarray, setval: float, infeed: float):
+    """Slot (3) or web (4) along _MA: its params, and the move before each of the two points."""
+    plane = call.plane
+    ma = call.integer("_MA")
+    if ma not in (1, 2):
+        raise CycleAlarm(alarms.MEASURING_AXIS, f"_MA = {ma}: slot and web are measured along the abscissa (1) "
+                         "or the ordinate (2)")
+    axis = plane.axes[ma - 1]
+    u = plane.unit(axis)
+    params.update({"axis": axis, "direction": "+", "direction_p2": "-",
+                   "setpoint": {axis: float(start @ u)}})
+    probe = _probe(env)
+    fa, feed = call.fa, _position_feed(env)
+    if kind == 3:
+        def before_slot_point(n, u=u):
+            d = u if n == 1 else -u
+            reach = max(0.0, setval / 2.0 - trigger_radius(probe, d, plane) - fa)
+            call.move(start + reach * d, feed)
+        return before_slot_point
+    low = start - infeed * plane.infeed_unit
+    side = setval / 2.0 + effective_radius(probe) + fa
+
+    def before_web_point(n, u=u):
         here = call.position()
-        call.move(here + float((start - here) @ plane.infeed_unit) * plane.infeed_unit, _position_feed(env))
-        call.move(start, _position_feed(env))
+        call.move(here + (float((start - here) @ plane.infeed_unit)) * plane.infeed_unit, feed)
+        over = start + (-side if n == 1 else side) * u
+        call.move(over, feed)
+        call.move(over + (low - start), feed)
+    return before_web_point
+
+
+def _results977(call: Call, answer: dict, kind: int, params: dict, s_ao: tuple[float, float], setval: float,
+                tool: bool) -> None:
+    """_OVR of CYCLE977 (measuring-math §8): setpoints, actual values, differences, tolerances."""
+    a, o = call.plane.first, call.plane.second
+    sa, so = s_ao
     result = answer.get("result") or {}
     centre = result.get("center") or {}
     if kind in (5, 6):
@@ -223,13 +217,43 @@ def cycle977(call: Call) -> None:
             tul, tll = (tul - tll) / 2.0, -(tul - tll) / 2.0
         for slot, value in ((8, tul), (9, tul), (12, tll), (13, tll)):
             call.ovr[slot] = call.out(value)
-    else:
-        size = float(result["distance"] if kind in (3, 4) else result["diameter"])
-        ca, co = centre.get(a, sa), centre.get(o, so)
-        _tolerance_results(call, answer, setval, tool)
-        for slot, value in ((1, sa), (2, so), (4, size), (5, ca), (6, co), (16, size - setval),
-                            (17, ca - sa), (18, co - so)):
-            call.ovr[slot] = call.out(value)
+        return
+    size = float(result["distance"] if kind in (3, 4) else result["diameter"])
+    ca, co = centre.get(a, sa), centre.get(o, so)
+    _tolerance_results(call, answer, setval, tool)
+    for slot, value in ((1, sa), (2, so), (4, size), (5, ca), (6, co), (16, size - setval),
+                        (17, ca - sa), (18, co - so)):
+        call.ovr[slot] = call.out(value)
+
+
+def cycle977(call: Call) -> None:
+    kind, zo = _variant977(call)
+    env = call.measuring()
+    setup = env.setup()
+    plane = call.plane
+    a, o = plane.first, plane.second
+    start = call.position()
+    sa, so, sp = (float(x) for x in plane.to_aop(start))
+    setval = call.length("_SETVAL")
+    target = call.zo_target(setup) if zo else call.tool_target()
+    tool = isinstance(target, dict)
+    spec = TASKS[_977_TASKS[kind]]
+    params: dict = {"setpoint": {a: sa, o: so}, "measurements": call.measurements()}
+    _with_points(call, kind, params)
+    tol_setpoint, before_point = _params977(call, env, kind, params, start, setval)
+    if tool:
+        params["tolerance"] = call.tolerance(tol_setpoint)
+    elif zo:
+        def differences(result):
+            centre = result.get("center") or {}
+            return [centre.get(k, s) - s for k, s in params["setpoint"].items()]
+        spec = with_finisher(spec, _check_safe_area(call, differences))
+    answer = call.run(env, spec, params, target, before_point=before_point)
+    if kind == 4:                                  # web: back up over the centre
+        here = call.position()
+        call.move(here + float((start - here) @ plane.infeed_unit) * plane.infeed_unit, _position_feed(env))
+        call.move(start, _position_feed(env))
+    _results977(call, answer, kind, params, (sa, so), setval, tool)
     call.common_results(answer)
 
 
@@ -342,7 +366,8 @@ def cycle979(call: Call) -> None:
 
 # --- CYCLE998 (measuring-math §11.1) -------------------------------------------------------------------
 
-def cycle998(call: Call) -> None:
+def _axes998(call: Call) -> tuple[int, int]:
+    """(offset axis, measuring axis) of _MA (1..3 in the plane) for the one-angle variants."""
     v = call.variant
     if v == 1105:
         raise variant_error(call, "the differential measurement (1105) is not supported")
@@ -357,6 +382,24 @@ def cycle998(call: Call) -> None:
         definition = alarms.MEASURING_AXIS
         extra = " (301/302: the offset axis along the applicate is not supported)" if offset_i == 3 else ""
         raise CycleAlarm(definition, f"_MA = {ma}: offset·100 + measuring axis: 102, 201, 103, 203{extra}")
+    return offset_i, measuring_i
+
+
+def _angle_correction998(call: Call) -> str:
+    """_RA: 0 rotates the ZO, else the channel's rotary axis number _RA takes the angle."""
+    ra = call.integer("_RA")
+    if ra == 0:
+        return "rotation"
+    axes = call.ctx.runtime.axes
+    if not 1 <= ra <= len(axes) or axes[ra - 1] in ("X", "Y", "Z"):
+        raise CycleAlarm(alarms.ROTARY_AXIS, f"_RA = {ra}: channel axis {ra} is not a rotary axis "
+                         f"(axes {' '.join(axes)})")
+    return axes[ra - 1]
+
+
+def cycle998(call: Call) -> None:
+    v = call.variant
+    offset_i, measuring_i = _axes998(call)
     env = call.measuring()
     setup = env.setup()
     plane = call.plane
@@ -369,15 +412,7 @@ def cycle998(call: Call) -> None:
     sta1 = call.real("_STA1")
     if not -45.0 <= sta1 <= 45.0:
         raise CycleAlarm(alarms.NC_VALUE_RANGE, f"_STA1 = {sta1:g}: the setpoint angle lies within −45..45°")
-    ra = call.integer("_RA")
-    if ra == 0:
-        correction = "rotation"
-    else:
-        axes = call.ctx.runtime.axes
-        if not 1 <= ra <= len(axes) or axes[ra - 1] in ("X", "Y", "Z"):
-            raise CycleAlarm(alarms.ROTARY_AXIS, f"_RA = {ra}: channel axis {ra} is not a rotary axis "
-                             f"(axes {' '.join(axes)})")
-        correction = axes[ra - 1]
+    correction = _angle_correction998(call)
     start = call.position()
     probe = _probe(env)
     tsa = abs(call.real("_TSA"))
@@ -437,6 +472,101 @@ def cycle998(call: Call) -> None:
 
 # --- CYCLE961 (measuring-math §12) ---------------------------------------------------------------------
 
+def _given_corner961(call: Call, start: np.ndarray, inner: bool, feed: float):
+    """117/118: the four given points _SETV[0..7] (a, o) at the depth _ID below the start:
+    (probing starts, directions, the reference edge's nominal angle, the move before each point)."""
+    plane = call.plane
+    a_hat, o_hat, p_hat = plane.unit(plane.first), plane.unit(plane.second), plane.infeed_unit
+    pts = [call.length("_SETV", (i,)) for i in range(8)]
+    ao = [np.array(pts[2 * i:2 * i + 2]) for i in range(4)]
+    h = float(start @ p_hat)
+    given = [plane.to_xyz(np.array([q[0], q[1], h])) for q in ao]
+    depth_shift = call.length("_ID") * p_hat
+
+    def side_dir(p, q, others):
+        line = q - p
+        normal = np.array([-float(line @ o_hat), float(line @ a_hat)])
+        normal = normal[0] * a_hat + normal[1] * o_hat
+        toward = float(normal @ (0.5 * (others[0] + others[1]) - p))
+        travel = normal * (1.0 if toward > 0 else -1.0) * (-1.0 if inner else 1.0)
+        return _paraxial(plane, travel)
+
+    if np.linalg.norm(given[1] - given[0]) < 1e-9 or np.linalg.norm(given[3] - given[2]) < 1e-9:
+        raise CycleAlarm(alarms.POINTS_IDENTICAL, "P1 and P2 or P3 and P4 are identical")
+    d12 = side_dir(given[0], given[1], given[2:])
+    d34 = side_dir(given[2], given[3], given[:2])
+    starts = [g + depth_shift for g in given]
+    nominal_angle = math.degrees(math.atan2(float((given[1] - given[0]) @ o_hat),
+                                            float((given[1] - given[0]) @ a_hat)))
+
+    def before_point(n):
+        here = call.position()
+        top = here + float((start - here) @ p_hat) * p_hat
+        call.move(top, feed)
+        above = starts[n - 1] - depth_shift
+        call.move(above, feed)
+        call.move(starts[n - 1], feed)
+    return starts, [d12, d12, d34, d34], nominal_angle, before_point
+
+
+def _edges_corner961(call: Call, start: np.ndarray, inner: bool, feed: float):
+    """105..108: two edges at _STA1 and _STA1 + _INCA, P2/P4 at _SETV[0]/[1] from the start:
+    (probing starts, directions, the reference edge's nominal angle, the move before each point)."""
+    plane = call.plane
+    p_hat = plane.infeed_unit
+    sta1, inca = call.real("_STA1"), call.real("_INCA")
+    l1, l2 = call.length("_SETV", (0,)), call.length("_SETV", (1,))
+    if not (l1 > 0.0 and l2 > 0.0):
+        raise CycleAlarm(alarms.NC_VALUE_RANGE, "_SETV[0], _SETV[1]: the distances from the start to P2 and "
+                         "P4 must be > 0")
+    e1, e2 = _ao_unit(plane, sta1), _ao_unit(plane, sta1 + inca)
+    perp1 = np.cross(p_hat, e1)
+    perp2 = np.cross(p_hat, e2)
+    n1 = perp1 if float(perp1 @ e2) > 0 else -perp1         # towards the second edge's side
+    n2 = perp2 if float(perp2 @ e1) > 0 else -perp2
+    sign = -1.0 if inner else 1.0                            # outer: into the material
+    d1, d2 = _paraxial(plane, sign * n1), _paraxial(plane, sign * n2)
+    starts = [start + l1 / 2.0 * e1, start + l1 * e1, start + l2 / 2.0 * e2, start + l2 * e2]
+    lift = call.length("_ID")
+
+    def before_point(n):
+        if n == 3 and not inner and lift > 0.0:
+            here = call.position()
+            call.move(here + lift * p_hat, feed)
+            call.move(starts[2] + lift * p_hat, feed)
+        elif n == 3:
+            call.move(start, feed)
+        call.move(starts[n - 1], feed)
+    return starts, [d1, d1, d2, d2], sta1, before_point
+
+
+def _corner_setpoint961(call: Call, right: bool) -> dict[str, float]:
+    """The corner's setpoint: 0, or for the right-angled corner the zero shifted by _SETV[4]."""
+    plane = call.plane
+    if not right:
+        return {plane.first: 0.0, plane.second: 0.0}
+    shift = int(call.real("_SETV", (4,)) or 1)
+    if shift not in (1, 2, 3, 4):
+        raise CycleAlarm(alarms.NC_VALUE_RANGE, f"_SETV[4] = {shift}: 1 corner, 2/3/4 shifted zero")
+    s2, s3 = call.length("_SETV", (2,)), call.length("_SETV", (3,))
+    return {plane.first: -s2 if shift in (2, 3) else 0.0, plane.second: -s3 if shift in (3, 4) else 0.0}
+
+
+def _results961(call: Call, answer: dict, found: dict, depth: float) -> None:
+    """_OVR: [4] the angle in the WCS, [5, 6] the corner (WCS), [20] the angle, [21, 22] the corner in the MCS."""
+    plane = call.plane
+    a_hat, o_hat = plane.unit(plane.first), plane.unit(plane.second)
+    corner = (answer.get("result") or {})["corner"]
+    k_wcs = plane.to_xyz(np.array([corner[plane.first], corner[plane.second], depth]))
+    chain = found["chain"]
+    k_mcs = chain.child2parent(k_wcs)
+    phi_w = found["angle"]
+    d_mcs = chain.dir_child2parent(_ao_unit(plane, phi_w))
+    phi_m = math.degrees(math.atan2(float(d_mcs @ o_hat), float(d_mcs @ a_hat)))
+    call.ovr.update({4: phi_w, 5: call.out(corner[plane.first]), 6: call.out(corner[plane.second]),
+                     20: phi_m, 21: call.out(float(k_mcs @ a_hat)), 22: call.out(float(k_mcs @ o_hat))})
+
+
 def cycle961(call: Call) -> None:
     v = call.variant
     if v not in (105, 106, 107, 108, 117, 118):
@@ -446,80 +576,18 @@ def cycle961(call: Call) -> None:
     env = call.measuring(measuring_path=max(call.fa, 20.0))     # internal minimum path 2·20 mm (measuring-math §12.2)
     setup = env.setup()
     plane = call.plane
-    a_hat, o_hat, p_hat = plane.unit(plane.first), plane.unit(plane.second), plane.infeed_unit
+    p_hat = plane.infeed_unit
     start = call.position()
     feed = _position_feed(env)
     right = v in (105, 106)
-    depth_shift = np.zeros(3)
-    if v in (117, 118):
-        pts = [call.length("_SETV", (i,)) for i in range(8)]
-        ao = [np.array(pts[2 * i:2 * i + 2]) for i in range(4)]
-        h = float(start @ p_hat)
-        given = [plane.to_xyz(np.array([q[0], q[1], h])) for q in ao]
-        depth_shift = call.length("_ID") * p_hat
-
-        def side_dir(p, q, others):
-            line = q - p
-            normal = np.array([-float(line @ o_hat), float(line @ a_hat)])
-            normal = normal[0] * a_hat + normal[1] * o_hat
-            toward = float(normal @ (0.5 * (others[0] + others[1]) - p))
-            travel = normal * (1.0 if toward > 0 else -1.0) * (-1.0 if inner else 1.0)
-            return _paraxial(plane, travel)
-
-        if np.linalg.norm(given[1] - given[0]) < 1e-9 or np.linalg.norm(given[3] - given[2]) < 1e-9:
-            raise CycleAlarm(alarms.POINTS_IDENTICAL, "P1 and P2 or P3 and P4 are identical")
-        d12 = side_dir(given[0], given[1], given[2:])
-        d34 = side_dir(given[2], given[3], given[:2])
-        starts = [g + depth_shift for g in given]
-        dirs = [d12, d12, d34, d34]
-        nominal_angle = math.degrees(math.atan2(float((given[1] - given[0]) @ o_hat),
-                                                float((given[1] - given[0]) @ a_hat)))
-
-        def before_point(n):
-            here = call.position()
-            top = here + float((start - here) @ p_hat) * p_hat
-            call.move(top, feed)
-            above = starts[n - 1] - depth_shift
-            call.move(above, feed)
-            call.move(starts[n - 1], feed)
-    else:
-        sta1, inca = call.real("_STA1"), call.real("_INCA")
-        l1, l2 = call.length("_SETV", (0,)), call.length("_SETV", (1,))
-        if not (l1 > 0.0 and l2 > 0.0):
-            raise CycleAlarm(alarms.NC_VALUE_RANGE, "_SETV[0], _SETV[1]: the distances from the start to P2 and "
-                             "P4 must be > 0")
-        e1, e2 = _ao_unit(plane, sta1), _ao_unit(plane, sta1 + inca)
-        perp1 = np.cross(p_hat, e1)
-        perp2 = np.cross(p_hat, e2)
-        n1 = perp1 if float(perp1 @ e2) > 0 else -perp1         # towards the second edge's side
-        n2 = perp2 if float(perp2 @ e1) > 0 else -perp2
-        sign = -1.0 if inner else 1.0                            # outer: into the material
-        d1, d2 = _paraxial(plane, sign * n1), _paraxial(plane, sign * n2)
-        starts = [start + l1 / 2.0 * e1, start + l1 * e1, start + l2 / 2.0 * e2, start + l2 * e2]
-        dirs = [d1, d1, d2, d2]
-        nominal_angle = sta1
-        lift = call.length("_ID")
-
-        def before_point(n):
-            if n == 3 and not inner and lift > 0.0:
-                here = call.position()
-                call.move(here + lift * p_hat, feed)
-                call.move(starts[2] + lift * p_hat, feed)
-            elif n == 3:
-                call.move(start, feed)
-            call.move(starts[n - 1], feed)
+    corner_of = _given_corner961 if v in (117, 118) else _edges_corner961
+    starts, dirs, nominal_angle, before_point = corner_of(call, start, inner, feed)
     n_points = 3 if right else 4
     starts, dirs = starts[:n_points], dirs[:n_points]
     spec = TASKS["corner.right" if right else "corner.any"]
     spec = with_planner(spec, lambda params, n, s, ctx, label: edge_program(dirs[n - 1], s, ctx, label))
     target = call.zo_target(setup)
-    setpoint = {plane.first: 0.0, plane.second: 0.0}
-    if right:
-        shift = int(call.real("_SETV", (4,)) or 1)
-        if shift not in (1, 2, 3, 4):
-            raise CycleAlarm(alarms.NC_VALUE_RANGE, f"_SETV[4] = {shift}: 1 corner, 2/3/4 shifted zero")
-        s2, s3 = call.length("_SETV", (2,)), call.length("_SETV", (3,))
-        setpoint = {plane.first: -s2 if shift in (2, 3) else 0.0, plane.second: -s3 if shift in (3, 4) else 0.0}
+    setpoint = _corner_setpoint961(call, right)
     found: dict = {}
 
     def turn(original):
@@ -538,24 +606,13 @@ def cycle961(call: Call) -> None:
               "measurements": call.measurements()}
     order = [2, 1, 3] if right else [2, 1, 3, 4]
     answer = call.run(env, with_finisher(spec, turn), params, target, before_point=before_point, order=order)
-    # back to the start (the way the probe came)
+    # back to the start (the way the probe came: up first from the given points' depth)
     here = call.position()
     if v in (117, 118):
         call.move(here + float((start - here) @ p_hat) * p_hat, feed)
-    elif not inner and call.length("_ID") > 0.0:
-        call.move(start, feed)
     else:
         call.move(start, feed)
-    result = answer.get("result") or {}
-    corner = result["corner"]
-    k_wcs = plane.to_xyz(np.array([corner[plane.first], corner[plane.second], float(starts[0] @ p_hat)]))
-    chain = found["chain"]
-    k_mcs = chain.child2parent(k_wcs)
-    phi_w = found["angle"]
-    d_mcs = chain.dir_child2parent(_ao_unit(plane, phi_w))
-    phi_m = math.degrees(math.atan2(float(d_mcs @ o_hat), float(d_mcs @ a_hat)))
-    call.ovr.update({4: phi_w, 5: call.out(corner[plane.first]), 6: call.out(corner[plane.second]),
-                     20: phi_m, 21: call.out(float(k_mcs @ a_hat)), 22: call.out(float(k_mcs @ o_hat))})
+    _results961(call, answer, found, float(starts[0] @ p_hat))
     call.ovi[11] = 1 if target != "measure_only" else 0
 
 
