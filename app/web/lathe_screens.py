@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from markupsafe import Markup
 
-from app.i18n import _
+from app.i18n import N_, _
 from app.workflow.executor import StepExecutor
 from engine.turning_plan import lathe_planned_path, prepare
 from engine.types import MoveStep, ProbeStep
@@ -28,32 +28,32 @@ def lathe_result_rows(result: dict) -> list[tuple[str, str, str]]:
     """(label, value text, unit): the turning §10.2 result keys; diameters labelled as such."""
     rows: list[tuple[str, str, str]] = []
     unit = DIA if result.get("unit") == "diameter" else "mm"
-    for key, label in (("diameter", "Diameter"), ("actual", "Actual value"), ("setpoint", "Setpoint"),
-                       ("deviation", "Deviation D"), ("mean_value", "Mean value Mv"),
-                       ("empirical_value", "Empirical value EV")):
+    for key, label in (("diameter", N_("Diameter")), ("actual", N_("Actual value")), ("setpoint", N_("Setpoint")),
+                       ("deviation", N_("Deviation D")), ("mean_value", N_("Mean value Mv")),
+                       ("empirical_value", N_("Empirical value EV"))):
         value = result.get(key)
         if isinstance(value, int | float) and not isinstance(value, bool):
             if key == "actual" and "diameter" in result:
                 continue                          # CYCLE994: its actual value is the diameter
-            rows.append((label, fmt_result(key, value), unit))
+            rows.append((_(label), fmt_result(key, value), unit))
     if isinstance(result.get("compensation"), int | float):
-        rows.append(("Compensation (radius)", fmt_result("compensation", result["compensation"]), "mm"))
+        rows.append((_("Compensation (radius)"), fmt_result("compensation", result["compensation"]), "mm"))
     for name, data in (result.get("length") or {}).items():
-        rows.append((f"{name} measured", fmt_result("length", data["actual"]), "mm"))
-        rows.append((f"{name} difference", fmt_result("length", data["difference"]), "mm"))
+        rows.append((_("%(name)s measured") % {"name": name}, fmt_result("length", data["actual"]), "mm"))
+        rows.append((_("%(name)s difference") % {"name": name}, fmt_result("length", data["difference"]), "mm"))
     if isinstance(result.get("radius"), dict):
-        rows.append(("R measured", fmt_result("radius", result["radius"]["actual"]), "mm"))
+        rows.append((_("%(name)s measured") % {"name": "R"}, fmt_result("radius", result["radius"]["actual"]), "mm"))
     for key, value in (result.get("trigger") or {}).items():
-        rows.append((f"Trigger {key}", fmt_result("trigger", value), "mm"))
+        rows.append((_("Trigger %(direction)s") % {"direction": key}, fmt_result("trigger", value), "mm"))
         diff = (result.get("difference") or {}).get(key) if isinstance(result.get("difference"), dict) else None
         if diff is not None:
-            rows.append((f"Difference {key}", fmt_result("difference", diff), "mm"))
+            rows.append((_("Difference %(direction)s") % {"direction": key}, fmt_result("difference", diff), "mm"))
     for axis, value in (result.get("skew") or {}).items():
-        rows.append((f"Position deviation {axis}", fmt_result("skew", value), "mm"))
+        rows.append((_("Position deviation %(axis)s") % {"axis": axis}, fmt_result("skew", value), "mm"))
     if isinstance(result.get("effective_diameter"), int | float):
-        rows.append(("Effective ball diameter", fmt_result("d", result["effective_diameter"]), "mm"))
+        rows.append((_("Effective ball diameter"), fmt_result("d", result["effective_diameter"]), "mm"))
     if result.get("written"):
-        rows.append(("Written", ", ".join(result["written"]), ""))
+        rows.append((_("Written"), ", ".join(result["written"]), ""))
     return rows
 
 
@@ -76,26 +76,26 @@ def lathe_correction_rows(correction: dict) -> list[dict]:
 
     if "trans" in after:
         for axis, new in (after.get("trans") or {}).items():
-            add(f"Offset {axis}", f"trans.{axis}", (before.get("trans") or {}).get(axis), new)
+            add(_("Offset %(axis)s") % {"axis": axis}, f"trans.{axis}", (before.get("trans") or {}).get(axis), new)
         return rows
     if "l1" in after:
         for key, label in LATHE_TOOL_FIELDS:
             add(label, key, before.get(key), after.get(key))
         for key, label in LATHE_TOOL_FIELDS:
-            add(f"Wear {label}", f"wear.{key}", (before.get("wear") or {}).get(key), (after.get("wear") or {}).get(key))
+            add(_("Wear %(name)s") % {"name": label}, f"wear.{key}", (before.get("wear") or {}).get(key), (after.get("wear") or {}).get(key))
         return rows
     if "trigger" in after:
         for key, new in (after.get("trigger") or {}).items():
-            add(f"Trigger {key}", f"trigger.{key}", (before.get("trigger") or {}).get(key), new)
-        add("Effective diameter", "effective_diameter", before.get("effective_diameter"),
+            add(_("Trigger %(direction)s") % {"direction": key}, f"trigger.{key}", (before.get("trigger") or {}).get(key), new)
+        add(_("Effective diameter"), "effective_diameter", before.get("effective_diameter"),
             after.get("effective_diameter"))
         for axis, new in (after.get("position_deviation") or {}).items():
-            add(f"Position deviation {axis}", f"position_deviation.{axis}",
+            add(_("Position deviation %(axis)s") % {"axis": axis}, f"position_deviation.{axis}",
                 (before.get("position_deviation") or {}).get(axis), new)
         return rows
     for key, new in after.items():                       # _TP / _TPW faces
         if isinstance(new, int | float):
-            add(f"Face {key}", key, before.get(key), new)
+            add(_("Face %(direction)s") % {"direction": key}, key, before.get(key), new)
     return rows
 
 

@@ -270,3 +270,18 @@ def test_lathe_screens_speak_the_operators_words(tab, lathe, lang):
         expect(feed).not_to_have_text(re.compile("Measuring feed"))
         expect(tab.locator('[data-field="tolerance.zero_range"] .label-main')).not_to_have_text(
             re.compile("Zero offset range"))
+
+
+def test_lathe_results_in_the_operators_language(tab, lathe):
+    """The result and correction rows and the set-up picture of a lathe screen in German."""
+    lathe.tool(8)
+    lathe.ball_to(20.0, 80.0)
+    tab.goto("/jog?lang=de")
+    tab.goto("/measure/lathe/surface")
+    fill(tab, axis="Z", direction="-", setpoint=60, measuring_path=3, tolerance__safe_area=4)
+    nc_start(tab)
+    expect(result(tab, "Schaltwert Z-")).to_have_text(re.compile(r"^2[.,]995$"))
+    box = tab.locator("#task-result")
+    for english in ("Trigger", "Position deviation", "Effective", "Written"):
+        expect(box).not_to_contain_text(english)
+    expect(tab.locator("#task-svg figcaption").first).to_contain_text("Reale Aufspannung")
