@@ -15,6 +15,7 @@ import gc
 import re
 import threading
 from bisect import bisect_left, bisect_right
+from collections import OrderedDict
 from collections.abc import Callable
 from contextlib import contextmanager
 from functools import lru_cache
@@ -223,10 +224,39 @@ def refuse_out_of_scope(text: str) -> None:
                                 alarm=alarms.NC_NAME_UNKNOWN, block_text=line.strip())
 
 
+#: the last programs read, by (text, name): the channel reads one text several times (the check
+#: when it is stored, the load when it is selected, again at NC Start after its end); the nodes
+#: are immutable, so the readers share them. Two: a long program is tens of MB of nodes.
+_read: OrderedDict[tuple[str, str], n.Program] = OrderedDict()
+_read_lock = threading.Lock()
+_READ_KEPT = 2
+
+
 def parse_program(text: str, name: str = "MDA") -> n.Program:
     """Parse and check ``text``; raises ``NcSyntaxError`` with line and column."""
     if not isinstance(text, str):
         raise TypeError("program text must be a str")
+    key = (text, name)
+    with _read_lock:
+        program = _read.get(key)
+        if program is not None:
+            _read.move_to_end(key)
+    if program is None:
+        program = _parse(text, name)
+        with _read_lock:
+            _read[key] = program
+            while len(_read) > _READ_KEPT:
+                _read.popitem(last=False)
+    return program
+
+
+def forget_programs() -> None:
+    """Read every program again (bench/bench_nc_parse.py times the reading itself)."""
+    with _read_lock:
+        _read.clear()
+
+
+def _parse(text: str, name: str) -> n.Program:
     source = text.replace("\r\n", "\n").replace("\r", "\n")
     lines = source.split("\n")
     for number, line in enumerate(lines, start=1):

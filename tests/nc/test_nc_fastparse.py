@@ -157,3 +157,22 @@ def test_a_long_program_is_read_by_the_fast_reader():
     text = "\n".join(f"N{i} G1 X{i % 100}.5 Y-{i % 37}.25 Z=R1+{i % 7}*2 F500 ; point {i}" for i in range(1, 2000))
     assert read_blocks(text.split("\n")) is not None
     assert p.parse_program(text, "T") == _lark(text)
+
+
+def test_the_same_text_is_read_once_and_shared():
+    """The channel reads one text several times (check, load, NC Start after the end): the last
+    two readings are kept; the nodes are immutable, so sharing them changes nothing."""
+    p.forget_programs()
+    text = "N10 G1 X10 F100\nN20 R1=R2+1\nM30"
+    first = p.parse_program(text, "KEPT")
+    assert p.parse_program(text, "KEPT") is first
+    assert p.parse_program(text, "OTHER") is not first and p.parse_program(text, "OTHER") == \
+        p._parse(text, "OTHER")
+    p.parse_program("M30", "A")
+    p.parse_program("M30", "B")
+    assert p.parse_program(text, "KEPT") is not first            # two others read since: read again
+    assert p.parse_program(text, "KEPT") == first
+    with pytest.raises(NcSyntaxError):
+        p.parse_program("G1 X=", "BAD")
+    with pytest.raises(NcSyntaxError):                           # errors are not kept: the same error again
+        p.parse_program("G1 X=", "BAD")
