@@ -83,6 +83,12 @@ def test_the_lock_in_german(browser, locked_server):
         expect(lock).to_contain_text("NC-Start gesperrt")
         expect(lock).to_contain_text("erfordert Stufe 3")
         expect(page.locator("#nc-start")).to_have_attribute("title", re.compile("erfordert Stufe 3"))
+        page.goto("/settings")                                # a denied softkey says why in German too
+        save = page.locator('#vsoftkeys [data-key="S-F1"]')
+        expect(save).to_be_disabled()
+        expect(save.locator(".why")).to_have_text("erfordert Stufe 3")
+        expect(save).to_have_attribute("title", re.compile("Schlüsselschalter|Kennwort"))
+        expect(page.locator("#settings-read-only")).to_contain_text("erfordert Stufe 3")
 
 
 def test_a_level_that_may_calibrate_has_no_lock(browser, locked_server):
