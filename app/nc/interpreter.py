@@ -19,6 +19,7 @@ The channel keeps its modal state from one program (or MDA run) to the next, lik
 
 from __future__ import annotations
 
+import logging
 import math
 import threading
 import time
@@ -61,6 +62,7 @@ from .runtime import MeasureResult, NcRuntime
 from .scope import refusal
 from .variables import CallbackBacking, VarDef, VariableError, Variables
 
+log = logging.getLogger(__name__)
 CycleHandler = Callable[["CycleContext"], None]
 
 _PLANES = {17: "G17", 18: "G18", 19: "G19"}
@@ -533,7 +535,8 @@ class Interpreter:
         except MeasuringError as e:
             raise NcAlarm(e.message, block.line, block.pos.column, alarm=e.definition,
                           block_text=block.text) from None
-        except Exception as e:
+        except Exception as e:          # a bug: the channel alarms, the log keeps the traceback
+            log.exception("NC block %s (line %s): internal error", block.text, block.line)
             raise NcAlarm(f"internal error: {e}", block.line, block.pos.column, alarm=alarms.NC_INTERNAL,
                           block_text=block.text) from e
 
@@ -859,7 +862,8 @@ class Interpreter:
             raise self._alarm(word, e.alarm, f"{word.name}: {e.message}") from None
         except EvalError as e:
             raise self._alarm(word, e.alarm, f"{word.name}: {e.message}") from None
-        except Exception as e:
+        except Exception as e:          # a bug: the channel alarms, the log keeps the traceback
+            log.exception("NC cycle %s: internal error", word.name)
             raise self._alarm(word, alarms.NC_INTERNAL, f"{word.name}: internal error: {e}") from e
 
     # --- machine state at program start --------------------------------------------------------------

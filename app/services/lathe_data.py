@@ -103,18 +103,15 @@ class GrooveService:
             records = unit.get_state(STATE_GROOVES, None) or [{} for _ in range(GROOVE_RECORDS)]
         return [{"number": i + 1, **record} for i, record in enumerate(records)]
 
-    def _number(self, n) -> int:
-        return checks.integer(n, "n", lo=1, hi=GROOVE_RECORDS)
-
     def get(self, n: int) -> dict:
-        n = self._number(n)
+        n = checks.integer(n, "n", lo=1, hi=GROOVE_RECORDS)
         records = self.list()
         if n > len(records):
             raise NotFoundError(f"no groove record {n}", code="unknown_groove")
         return records[n - 1]
 
     def put(self, n: int, values) -> dict:
-        n = self._number(n)
+        n = checks.integer(n, "n", lo=1, hi=GROOVE_RECORDS)
         record = check_groove(values)
         with self._db.unit() as unit:
             records = unit.get_state(STATE_GROOVES, None) or [{} for _ in range(GROOVE_RECORDS)]
