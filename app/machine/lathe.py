@@ -52,6 +52,7 @@ from .lathe_scene import LatheContact, lathe_outline, tool_outline
 from .nc_data import NcData, _object
 from .probe_signal import TOOL, WORKPIECE
 from .protocol import MachineBusy, MachineStatus
+from .scene import protection_data
 from .simulated import SimulatedControl
 
 LATHE_TOOL_KEYS = ("type", "length", "radius", "wear", "sl", "l1", "l2")
@@ -127,6 +128,16 @@ class LatheMachine(SimulatedControl):
     @property
     def spos_capable(self) -> bool:
         return bool(self._scenario.machine.spos)
+
+    # --- protection model (the start guard, issue 24 §1) ------------------------------------------
+    def protection_model(self) -> dict:
+        """The solids and axis limits the control protects (plain data, MCS, X a radius): the
+        lathe's commissioned model of its work space is its scene at the spindle's angle now
+        (the part, the chuck, the reference grooves, the tool probe)."""
+        with self._lock:
+            scene = self._contact.scene(self._spindle_angle)
+            limits = {a: [float(lo), float(hi)] for a, (lo, hi) in self._kinematics.limits.items()}
+        return {"bodies": protection_data(scene), "limits": limits}
 
     # --- status -----------------------------------------------------------------------------
     def _lengths(self) -> tuple[float, float]:

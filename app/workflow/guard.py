@@ -4,9 +4,10 @@ a refused path answers 409 ``guard`` naming the alarm and the segment, and nothi
 
 The model comes from the machine (``protection_model()``: the simulator's is its work space); a
 controller without one gives the verdict ``unknown`` for every positioning move, shown in the
-plan and the session's warnings (never a silent pass). Tool measuring (the cutter, MCS
-coordinates), the lathe tasks and ``kinematics.measure`` are not checked for collisions: their
-plan says ``unknown`` and NC Start warns (``NOT_MODELLED``).
+plan and the session's warnings (never a silent pass). The lathe's workpiece-probe tasks are
+checked against the lathe's model (the ball centre is the NC's P = F − (L1, 0, L2)). Tool
+measuring (the cutter around the tool probe) and ``kinematics.measure`` are not checked for
+collisions: their plan says ``unknown`` and NC Start warns (``NOT_MODELLED``).
 
 Every task's probing moves are checked against the probe's own reach (measuring-math §1.3) when
 the machine knows its braking (``ProbeReach``): braking behind the switch beyond the permissible
@@ -42,8 +43,6 @@ UNKNOWN_WARNING = N_("Start guard: the control has no model of the work space: t
 NOT_MODELLED = {      # why a task's path is not checked for collisions (issue 24 §1: say so)
     "tool": N_("Start guard: tool measuring is not checked for collisions (the HMI has no model of the "
                "cutter around the tool probe); watch the tool"),
-    "lathe": N_("Start guard: the lathe tasks are not checked for collisions (the HMI has no model of "
-                "the turned part, the chuck and the turret); watch the probe"),
     "kinematics": N_("Start guard: the kinematics measurement is not checked for collisions (the guard "
                      "does not model the swivel moves); watch the probe"),
 }
@@ -60,9 +59,7 @@ def protection_data(machine) -> dict | None:
 
 def not_modelled_warning(spec) -> str:
     """The note NC Start gives for a task the guard does not check for collisions."""
-    if getattr(spec, "lathe", False):
-        return NOT_MODELLED["lathe"]
-    if spec.probe_used == "tool" or not spec.needs_probe:
+    if spec.probe_used == "tool" or (not spec.needs_probe and not getattr(spec, "lathe", False)):
         return NOT_MODELLED["tool"]
     return NOT_MODELLED["kinematics"]
 
@@ -79,8 +76,11 @@ def braking_for(machine, spec) -> Braking | None:
 
 
 def guarded(spec) -> bool:
-    """Workpiece-probe tasks in the WCS are checked; tool measuring and the lathe are not."""
-    return bool(spec.needs_probe) and not getattr(spec, "lathe", False) and bool(getattr(spec, "guarded", True))
+    """Workpiece-probe tasks are checked (the lathe's too); tool measuring and
+    ``kinematics.measure`` are not."""
+    if getattr(spec, "lathe", False):
+        return bool(getattr(spec, "uses_workpiece_probe", False))
+    return bool(spec.needs_probe) and bool(getattr(spec, "guarded", True))
 
 
 def check_point(machine, spec, params: dict, n: int, ctx) -> tuple[GuardReport, str]:
@@ -92,14 +92,18 @@ def check_point(machine, spec, params: dict, n: int, ctx) -> tuple[GuardReport, 
     start = executor.current(coords)
     program = spec.program(params, n, start, plan_ctx)
     braking = braking_for(machine, spec)
-    if not guarded(spec) or coords != "WCS":
-        return _unknown(ideal_path(program, start), start, braking), coords
     wcs2bcs = ctx.chain().wcs2bcs
     tip = executor.tip_conversion
-    placement = Placement(rotation=np.asarray(wcs2bcs.rotation, dtype=float),
-                          ball_shift=np.asarray(wcs2bcs.child2parent(ball_offset(plan_ctx)), dtype=float),
-                          axes_shift=np.asarray(tip.axes_for_tip(np.zeros(3), "WCS"), dtype=float),
-                          ball_radius=float(plan_ctx.probe.ball_diameter) / 2.0)
+    placement = None
+    if guarded(spec) and getattr(spec, "lathe", False):
+        placement = _lathe_placement(ctx, tip, coords, wcs2bcs)
+    elif guarded(spec) and coords == "WCS":
+        placement = Placement(rotation=np.asarray(wcs2bcs.rotation, dtype=float),
+                              ball_shift=np.asarray(wcs2bcs.child2parent(ball_offset(plan_ctx)), dtype=float),
+                              axes_shift=np.asarray(tip.axes_for_tip(np.zeros(3), "WCS"), dtype=float),
+                              ball_radius=float(plan_ctx.probe.ball_diameter) / 2.0)
+    if placement is None:
+        return _unknown(ideal_path(program, start), start, braking), coords
     return check_program(program, start, _model_of(protection_data(machine)), placement, braking), coords
 
 
@@ -116,6 +120,23 @@ def _model_of(data: dict | None) -> ProtectionModel:
     model = model_from_data(data)
     _model_cache = (data, model)
     return model
+
+
+def _lathe_placement(ctx, tip, coords: str, wcs2bcs) -> Placement | None:
+    """The lathe's probe (turning.md §0.4): its ball centre is the NC's reference point P (MCS =
+    the WCS point through the frames), the turret's axes F = P + (L1, 0, L2); X is a radius
+    everywhere here. None without the probe's ball (then the path is ``unknown``)."""
+    diameter = ctx.probe.ball_diameter if ctx.probe is not None else (ctx.probe_data or {}).get("ball_diameter")
+    if not diameter:
+        return None
+    if coords == "WCS":
+        rotation = np.asarray(wcs2bcs.rotation, dtype=float)
+        ball_shift = np.asarray(wcs2bcs.child2parent(np.zeros(3)), dtype=float)
+    else:
+        rotation, ball_shift = np.eye(3), np.zeros(3)
+    return Placement(rotation=rotation, ball_shift=ball_shift,
+                     axes_shift=np.asarray(tip.axes_for_tip(np.zeros(3), coords), dtype=float),
+                     ball_radius=float(diameter) / 2.0)
 
 
 def _unknown(steps, start, braking: Braking | None = None) -> GuardReport:

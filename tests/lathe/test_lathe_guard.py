@@ -1,8 +1,12 @@
-"""The start guard on the lathe (issue 24 §1): the HMI has no model of the turned part, the chuck
-and the turret, so the lathe tasks are not checked for collisions; NC Start says so in its
-warnings and the plan's positioning moves are ``unknown`` (no silent pass). The probe's own
-reach (measuring-math §1.3) is checked: a measuring feed whose braking would push the tool probe
-beyond its permissible deflection (1 mm in turning.md §10.2's scenario) is refused before motion.
+"""The start guard on the lathe (issue 24 §1, §2): the workpiece probe's tasks are checked against
+the lathe's model of its work space (the part, the chuck, the reference grooves, the tool probe):
+each runs from a start just above the feature (measured, the truth of turning.md §10.2) and from
+the far side of the turning centre (refused before anything moves, never a collision). Tool
+measuring on the lathe is not checked for collisions (the HMI has no model of the cutter around
+the tool probe): NC Start says so and its positioning moves are ``unknown`` (no silent pass).
+The probe's own reach (measuring-math §1.3) is checked for every task: a measuring feed whose
+braking would push the tool probe beyond its permissible deflection (1 mm in turning.md §10.2's
+scenario) is refused before motion.
 
 Truth: the scenario's machine data (latency 0 s, deceleration 1 m/s², Kv 1 (m/min)/mm, the lathe
 scenario's defaults) in the formula worked by hand, and the simulator, which with the guard off
@@ -94,5 +98,61 @@ def test_a_feed_within_the_deflection_measures_and_says_what_is_not_checked(lath
     probe = [s for s in plan["segments"] if s["kind"] == "probe"][0]
     assert probe["braking"] == pytest.approx(0.65, abs=1e-9)
     answer = lathe.ok(lathe.c.post(f"/api/measure/{session['id']}/start", json={}))
-    assert any(w.startswith("Start guard: the lathe tasks are not checked for collisions") for w in answer["warnings"])
+    assert any(w.startswith("Start guard: tool measuring is not checked for collisions") for w in answer["warnings"])
     assert answer["result"]["length"]["L1"]["actual"] == pytest.approx(100.70, abs=1e-9)     # the true L1 of T3
+
+
+# --- safe approaches: from just above the feature and from the far side ------------------------------
+
+SHAFT_D, ECCENTRICITY_X = 45.006, 0.030          # the scenario's shaft, clamped 0.030 off centre in X
+BALL_R = 3.0                                     # the probe's nominal ball (Ø6)
+ABOVE_D = SHAFT_D + 2 * (BALL_R + 1.0)           # ball 1 mm above the shaft (a diameter, DIAMON)
+
+# task, params, start (WCS: X a diameter, Z), outcome: the measured value, "guard" (the start guard
+# refuses) or an alarm number (the cycle refuses before motion)
+SAFE_CASES = {
+    "point-X-above": ("lathe.point", {"axis": "X", "setpoint": 45, "measuring_path": 2}, (ABOVE_D, 30.0),
+                      # at SPOS 0 the single point reads the diameter plus twice the X eccentricity (5-C)
+                      SHAFT_D + 2 * ECCENTRICITY_X),
+    # straight through the shaft to its far side: the start guard refuses it
+    "point-X-far-side": ("lathe.point", {"axis": "X", "setpoint": 45, "measuring_path": 2}, (-ABOVE_D, 30.0),
+                         "guard"),
+    "point-Z-above": ("lathe.point", {"axis": "Z", "setpoint": 60, "measuring_path": 2}, (40.0, 60.0 + BALL_R + 1.0),
+                      60.0),                     # the face at Z 60, the probe over the ring between bore and OD
+    "two-point-above": ("lathe.two_point", {"axis": "X", "setpoint": 45, "zone": {"Z": 70, "X": 60},
+                                            "measuring_path": 2}, (ABOVE_D, 30.0), SHAFT_D),
+    # CYCLE994 itself refuses a start on the side of its second point (turning.md §6.3)
+    "two-point-far-side": ("lathe.two_point", {"axis": "X", "setpoint": 45, "zone": {"Z": 70, "X": 60},
+                                               "measuring_path": 2}, (-ABOVE_D, 30.0), "61307"),
+}
+
+
+def _probe_to(lathe: Lathe, x_diameter: float, z: float) -> None:
+    """Around the part: retract, out beyond its end face (Z 80), across, then along Z to the start."""
+    lathe.retract()
+    lathe.goto(coords="WCS", Z=80.0)
+    lathe.goto(coords="WCS", X=x_diameter)
+    lathe.goto(coords="WCS", Z=z)
+
+
+@pytest.mark.parametrize("case", sorted(SAFE_CASES))
+def test_lathe_tasks_from_above_and_from_the_far_side(lathe, case):
+    task, params, (x, z), outcome = SAFE_CASES[case]
+    lathe.calibrate_probe_in_groove()
+    _probe_to(lathe, x, z)
+    before, log = lathe.status(), lathe.ok(lathe.c.get("/api/log"))
+    session = lathe.ok(lathe.c.post("/api/measure", json={"task": task, "params": params}))
+    answer = lathe.c.post(f"/api/measure/{session['id']}/start", json={})
+    state = lathe.status()
+    assert all(a["code"] != 61302 for a in state["alarms"]), state["alarms"]         # never a collision
+    if isinstance(outcome, str):
+        assert answer.status_code == 409, answer.text
+        error = answer.json()["error"]
+        assert error["code"] == "guard" if outcome == "guard" else outcome in error["message"], error
+        assert state["mcs"] == before["mcs"] and not state["busy"]                    # nothing moved
+        if outcome == "guard":
+            assert lathe.ok(lathe.c.get("/api/log")) == log                           # nothing logged
+        return
+    assert answer.status_code == 200, answer.text
+    result = answer.json()["result"]
+    assert result.get("diameter", result["actual"]) == pytest.approx(outcome, abs=1e-6)
