@@ -3,10 +3,10 @@ per line, building the same nodes through ``build`` (issue 24 item 5: a 200 KB p
 under 1 s, where lark's LALR parser takes several).
 
 It reads only what it is sure lark reads the same way. Anything else (a syntax error, a word
-``build`` refuses, a keyword standing where lark's contextual lexer would read it as a name, an
-address letter with a sign inside an expression) makes it give the program up: ``read_blocks``
-answers None and ``parse_program`` runs lark on the whole program, which words every error as
-before. So a program reads the same whichever reader took it (tests/nc/test_nc_fastparse.py
+``build`` refuses, a keyword standing where lark's contextual lexer would read it as a name)
+makes it stop at that line: ``read_blocks`` answers the blocks before it and ``parse_program``
+runs lark from that line on (lark reads each line alike whatever came before), which words every
+error as before. So a program reads the same whichever reader took it (tests/nc/test_nc_fastparse.py
 compares the two on the test programs, the manual's listings and random blocks).
 """
 
@@ -80,18 +80,19 @@ def _tokens(line: str, at: int = 0) -> list[tuple[str, str, int]]:
     return out
 
 
-def read_blocks(lines: list[str]) -> list | None:
+def read_blocks(lines: list[str]) -> tuple[list, int]:
     """The program's blocks as lark's transformer gives them (``("HEADER", token)`` or
-    ``("BLOCK", items)``), or None: lark is to read this program."""
-    blocks = []
-    try:
-        for number, line in enumerate(lines, start=1):
+    ``("BLOCK", items)``) and the number of lines read: fewer than all when lark is to read the
+    rest (from the line after them)."""
+    blocks: list = []
+    for number, line in enumerate(lines, start=1):
+        try:
             block = _Line(line, number).block()
-            if block is not None:
-                blocks.append(block)
-    except (_GiveUp, NcSyntaxError):
-        return None
-    return blocks
+        except (_GiveUp, NcSyntaxError):
+            return blocks, number - 1
+        if block is not None:
+            blocks.append(block)
+    return blocks, len(lines)
 
 
 class _Line:

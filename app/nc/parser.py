@@ -262,9 +262,9 @@ def _parse(text: str, name: str) -> n.Program:
     for number, line in enumerate(lines, start=1):
         _scan_line(line, number)
     with _collector_paused():
-        raw_blocks = read_blocks(lines)         # the fast reader; None: lark reads it and words the error
-        if raw_blocks is None:
-            raw_blocks = _lark_blocks(source, lines)
+        raw_blocks, read = read_blocks(lines)       # the fast reader, up to a line it leaves to lark
+        if read < len(lines):                       # lark from there on (empty lines keep the numbers)
+            raw_blocks += _lark_blocks("\n" * read + "\n".join(lines[read:]), lines)
         return _assemble(raw_blocks, source, lines, name)
 
 

@@ -31,10 +31,10 @@ def _lark(text: str):
 
 
 def _fast(text: str):
-    """The fast reader's program, its error, or None when it leaves the program to lark."""
+    """The fast reader's program, its error, or None when it leaves a line to lark."""
     lines = text.split("\n")
-    blocks = read_blocks(lines)
-    if blocks is None:
+    blocks, read = read_blocks(lines)
+    if read < len(lines):
         return None
     try:
         return p._assemble(blocks, text, lines, "T")
@@ -155,7 +155,7 @@ def test_random_blocks_read_alike():
 
 def test_a_long_program_is_read_by_the_fast_reader():
     text = "\n".join(f"N{i} G1 X{i % 100}.5 Y-{i % 37}.25 Z=R1+{i % 7}*2 F500 ; point {i}" for i in range(1, 2000))
-    assert read_blocks(text.split("\n")) is not None
+    assert read_blocks(text.split("\n"))[1] == 1999
     assert p.parse_program(text, "T") == _lark(text)
 
 
@@ -176,3 +176,44 @@ def test_the_same_text_is_read_once_and_shared():
         p.parse_program("G1 X=", "BAD")
     with pytest.raises(NcSyntaxError):                           # errors are not kept: the same error again
         p.parse_program("G1 X=", "BAD")
+
+
+@pytest.mark.parametrize("odd, error", [
+    ("TRUE", False),                        # a keyword where lark reads a name: lark reads that line on
+    ("R1=AND+1", False),
+    ("G1 X10 )", True),                     # an error: lark's words, line and column
+    ("G1.5 X10", True),
+])
+def test_lark_reads_on_from_the_line_the_fast_reader_leaves(odd, error):
+    """A long program with one such line in the middle or at the end: the blocks before it are
+    the fast reader's, lark reads from there on, and the program (or the error) is lark's."""
+    lines = [f"N{i} G1 X{i % 100}.5 Y-{i % 37}.25 F500" for i in range(1, 400)]
+    for at in (150, len(lines)):
+        text = "\n".join([*lines[:at], odd, *lines[at:]])
+        assert read_blocks(text.split("\n"))[1] == at
+        truth = _lark(text)
+        assert isinstance(truth, tuple) is error
+        if error:
+            with pytest.raises(NcSyntaxError) as caught:
+                p._parse(text, "T")
+            assert (str(caught.value), caught.value.line, caught.value.column) == truth[1:]
+        else:
+            assert p._parse(text, "T") == truth
+
+
+def _read(text: str):
+    """``parse_program``'s reading (fast reader, then lark from the line it leaves), or its error."""
+    try:
+        return p._parse(text, "T")
+    except NcSyntaxError as e:
+        return ("error", str(e), e.line, e.column)
+
+
+def test_random_programs_read_as_lark_reads_them():
+    """Programs of several random blocks, most of them wrong somewhere: the program or the error
+    parse_program gives is lark's, whichever line the fast reader left to lark."""
+    rng = random.Random(28)
+    for _ in range(800):
+        text = "\n".join(_random_block(rng) for _ in range(rng.randint(2, 6)))
+        if _scans(text):
+            assert _read(text) == _lark(text), text
