@@ -108,6 +108,23 @@ def _validation_message(err: dict) -> str:
     return msg.removeprefix("Value error, ")
 
 
+def allowed_methods(request: Request) -> list[str]:
+    """The methods of every route whose path matches the request's (FastAPI has one route per
+    method; routers included lazily are flattened as fastapi.routing.iter_route_contexts does)."""
+    import fastapi.routing
+
+    flatten = getattr(fastapi.routing, "iter_route_contexts", None)
+    routes = flatten(request.app.router.routes) if flatten else request.app.router.routes
+    path = request.scope.get("path", "")
+    methods: set[str] = set()
+    for route in routes:
+        regex = getattr(route, "path_regex", None)
+        if regex is not None and regex.match(path):
+            methods.update(getattr(route, "methods", None) or ())
+    order = ("GET", "HEAD", "POST", "PUT", "PATCH", "DELETE", "OPTIONS")
+    return sorted(methods, key=lambda m: (order.index(m) if m in order else len(order), m))
+
+
 def install_handlers(app: FastAPI) -> None:
     @app.exception_handler(HmiError)
     async def _hmi_error(_: Request, exc: HmiError):
@@ -142,10 +159,16 @@ def install_handlers(app: FastAPI) -> None:
         return error_response(422, "validation", message, field)
 
     @app.exception_handler(StarletteHTTPException)
-    async def _http_error(_: Request, exc: StarletteHTTPException):
+    async def _http_error(request: Request, exc: StarletteHTTPException):
         code = {404: "not_found", 405: "method_not_allowed"}.get(exc.status_code, "http_error")
         response = error_response(exc.status_code, code, str(exc.detail))
-        response.headers.update(exc.headers or {})        # e.g. Allow of a 405 (RFC 9110 §15.5.6)
+        response.headers.update(exc.headers or {})
+        if exc.status_code == 405:
+            # every method the path has (RFC 9110 §15.5.6): Starlette names only the first route's,
+            # FastAPI has one route per method
+            allowed = allowed_methods(request)
+            if allowed:
+                response.headers["Allow"] = ", ".join(allowed)
         return response
 
     @app.exception_handler(StorageUnavailable)

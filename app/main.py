@@ -78,7 +78,7 @@ def build_services(settings: Settings, scenario: Scenario | LatheScenario) -> Se
     options = machine_options(settings)
     controller = build_machine(settings.machine, scenario, options)   # an unknown name fails before the db is touched
     db = Database(settings.database, rotary_axes=tuple(a for a in scenario.axes if a not in "XYZ"),
-                  machine=settings.machine_name)
+                  machine=settings.machine_name, stand_in=True)   # unreachable: read only (§10.8)
     gud = SettingsService(db)
     machine = MachineService(db, controller, scenario, gud,
                              rebuild=lambda other: build_machine(settings.machine, other, options))   # lathe <-> mill
@@ -103,6 +103,7 @@ def build_services(settings: Settings, scenario: Scenario | LatheScenario) -> Se
     services.plant = PlantService(db, machine.status)
     services.probe_test = ProbeTestService(machine)
     services.probe_health = ProbeHealthService(db, machine, gud)
+    db.start_up_done()
     return services
 
 

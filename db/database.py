@@ -21,7 +21,7 @@ from alembic.script import ScriptDirectory
 from sqlalchemy import URL, Connection, Engine, bindparam, create_engine, event, make_url, select, update
 from sqlalchemy.exc import DBAPIError, OperationalError
 from sqlalchemy.orm import Session
-from sqlalchemy.pool import ConnectionPoolEntry
+from sqlalchemy.pool import ConnectionPoolEntry, NullPool
 
 from db.models import Machine
 from db.repository import Unit, offset_layout, seed_defaults, utc_now
@@ -107,6 +107,7 @@ class Database:
         basic_frames: int = 2,
         rotary_axes: Sequence[str] = (),
         machine: str | None = None,
+        stand_in: bool = False,
     ):
         self.url = database_url(path)
         self.is_sqlite = self.url.get_backend_name() == "sqlite"
@@ -132,6 +133,8 @@ class Database:
             self._engine = create_engine(self.url, pool_pre_ping=True, connect_args={
                 "options": f"-c lock_timeout={BUSY_TIMEOUT_MS} -c timezone=UTC", "connect_timeout": 10})
             self._write_engine = self._engine
+        if stand_in and not self.is_sqlite and not self._reachable():
+            return
         try:
             file = self._sqlite_file()
             if file is not None:
@@ -150,6 +153,51 @@ class Database:
 
     # --- a database that can be read but not written (design.md §10.8) ------------------------
     read_only: str | None = None       # why nothing can be written (None: it can)
+    unreachable = False                # a PostgreSQL server that could not be reached: the stand-in serves
+
+    def _reachable(self) -> bool:
+        """PostgreSQL, opened with ``stand_in`` (the HMI server, not the command line's
+        administration): True when a connection can be made; else a stand-in is opened: an
+        in-memory SQLite database with this machine's default rows, which the start-up may fill
+        (default tools, the spindle's tool) until :meth:`start_up_done` makes it read only (nothing
+        stored can be shown; a write answers 503 as on a read-only file). Any error after
+        connecting (permissions, a broken migration) still stops the start."""
+        try:
+            with self._engine.connect():
+                return True
+        except (OSError, DBAPIError) as exc:
+            cause = exc
+        self._engine.dispose()
+        log.error("database %s cannot be reached: %s; serving read only with the default data",
+                  self.where, str(getattr(cause, "orig", None) or cause).strip())
+        self.is_sqlite, self.url, self.path = True, make_url("sqlite://"), None
+        # a shared in-memory database: a connection per checkout (threads never share one), kept
+        # alive by the keeper connection until close()
+        name = f"file:hmi-stand-in-{id(self):x}?mode=memory&cache=shared"
+
+        def connect() -> sqlite3.Connection:
+            connection = sqlite3.connect(name, uri=True, check_same_thread=False, isolation_level=None)
+            # readers take no table locks of the shared cache (a start-up write beside an open
+            # reading unit would else fail with "database table is locked")
+            connection.execute("PRAGMA read_uncommitted = 1")
+            return connection
+
+        self._stand_in_keeper = connect()
+        self._engine = create_engine("sqlite://", creator=connect, poolclass=NullPool)
+        event.listen(self._engine, "begin", _begin_transaction)
+        self._write_engine = self._engine
+        with self._engine.begin() as connection:
+            upgrade_to_head(connection, self.machine)
+        with Session(self._engine) as session, session.begin():
+            seed_defaults(session, self._layout, self._rotary_axes, self.machine)
+        self.unreachable = True
+        return False
+
+    def start_up_done(self) -> None:
+        """The stand-in of an unreachable database is read only from now on (see ``_reachable``)."""
+        if self.unreachable:
+            # the driver's words name the server's address: the log has them, a client's answer not
+            self.read_only = "the database cannot be reached"
 
     def _sqlite_file(self) -> Path | None:
         if not self.is_sqlite or self.path is None or str(self.path) in ("", ":memory:"):
@@ -295,6 +343,9 @@ class Database:
                 connection.close()
             self._count_connections.clear()
         self._engine.dispose()
+        keeper = getattr(self, "_stand_in_keeper", None)
+        if keeper is not None:
+            keeper.close()
 
     def __enter__(self) -> Database:
         return self

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import APIRouter, Body, Request, Response
+from fastapi import APIRouter, Body, Path, Request, Response
 from fastapi.concurrency import run_in_threadpool
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictInt, StrictStr
 
@@ -183,7 +183,7 @@ def add_user(request: Request, body: UserBody) -> dict:
 
 
 @router.delete("/users/{name}", name="api_user_delete", dependencies=[needs("users")])
-def delete_user(request: Request, name: str) -> dict:
+def delete_user(request: Request, name: Annotated[str, Path(min_length=1, max_length=64)]) -> dict:
     try:
         return access_of(request).delete_user(name)
     except AccessError as exc:
@@ -207,7 +207,7 @@ def add_token(request: Request, body: TokenBody) -> dict:
 
 
 @router.delete("/tokens/{name}", name="api_token_delete", dependencies=[needs("users")])
-def delete_token(request: Request, name: str) -> dict:
+def delete_token(request: Request, name: Annotated[str, Path(min_length=1, max_length=64)]) -> dict:
     try:
         return access_of(request).delete_token(name)
     except AccessError as exc:

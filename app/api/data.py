@@ -18,11 +18,16 @@ from app.deps import (
     ToolProbesDep,
     ToolsDep,
 )
+from app.records import MAX_PROBE, MAX_TOOL
 from app.services.memories import WRITE_FUNCTION as MEMORY_WRITE
 from app.services.undo import UNDO_FUNCTION, undo
 
 router = APIRouter(tags=["data"])
 JsonObject = Annotated[dict, Body()]
+# the numbers a path names, as the services check them (the schema says so: issue 25 item 7)
+ToolNumber = Annotated[int, Path(ge=1, le=MAX_TOOL, description=f"tool number T, 1..{MAX_TOOL}")]
+OffsetName = Annotated[str, Path(min_length=1, max_length=32, description="G54.., G505.., BASIC_REF, BASIC_n")]
+ProbeNumber = Annotated[int, Path(ge=1, le=MAX_PROBE, description=f"probe record number, 1..{MAX_PROBE}")]
 
 
 @router.get("/offsets", name="api_offsets")
@@ -32,19 +37,20 @@ def list_offsets(offsets: OffsetsDep) -> dict:
 
 
 @router.get("/offsets/{name}", name="api_offset_get")
-def get_offset(name: str, offsets: OffsetsDep) -> dict:
+def get_offset(name: OffsetName, offsets: OffsetsDep) -> dict:
     return offsets.get(name)
 
 
 @router.put("/offsets/{name}", name="api_offset_put", dependencies=[needs("offsets")])
-def put_offset(name: str, body: JsonObject, offsets: OffsetsDep) -> dict:
+def put_offset(name: OffsetName, body: JsonObject, offsets: OffsetsDep) -> dict:
     """Merges the given components onto the stored frame; audited with source "api"."""
     return offsets.put(name, body, source="api")
 
 
 @router.get("/audit", name="api_audit")
 def audit(offsets: OffsetsDep, limit: Annotated[int, Query(ge=1, le=1000)] = 50,
-          name: str | None = None, kind: str | None = None) -> list[dict]:
+          name: Annotated[str | None, Query(max_length=64)] = None,
+          kind: Annotated[str | None, Query(max_length=64)] = None) -> list[dict]:
     """Changes of stored data, newest first: ``kind`` (offset, tool, probe, tool_probe, memory,
     settings, scenario, user, token, keyswitch), ``offset`` the item, ``who`` and ``level``: the user
     or token that wrote it and its access level."""
@@ -73,18 +79,18 @@ def list_tools(tools: ToolsDep) -> list[dict]:
 
 
 @router.get("/tools/{t}", name="api_tool_get")
-def get_tool(t: int, tools: ToolsDep) -> dict:
+def get_tool(t: ToolNumber, tools: ToolsDep) -> dict:
     return tools.get(t)
 
 
 @router.put("/tools/{t}", name="api_tool_put", dependencies=[needs("tools")])
-def put_tool(t: int, body: JsonObject, tools: ToolsDep) -> dict:
+def put_tool(t: ToolNumber, body: JsonObject, tools: ToolsDep) -> dict:
     """Creates or updates tool ``t`` (fields not given keep their value)."""
     return tools.put(t, body)
 
 
 @router.delete("/tools/{t}", status_code=204, name="api_tool_delete", dependencies=[needs("tools")])
-def delete_tool(t: int, tools: ToolsDep) -> None:
+def delete_tool(t: ToolNumber, tools: ToolsDep) -> None:
     tools.delete(t)
 
 
@@ -94,12 +100,12 @@ def list_probes(probes: ProbesDep) -> list[dict]:
 
 
 @router.get("/probes/{n}", name="api_probe_get")
-def get_probe(n: int, probes: ProbesDep) -> dict:
+def get_probe(n: ProbeNumber, probes: ProbesDep) -> dict:
     return probes.get(n)
 
 
 @router.put("/probes/{n}", name="api_probe_put", dependencies=[needs("probe_data")])
-def put_probe(n: int, body: JsonObject, probes: ProbesDep) -> dict:
+def put_probe(n: ProbeNumber, body: JsonObject, probes: ProbesDep) -> dict:
     return probes.put(n, body)
 
 
@@ -109,12 +115,12 @@ def list_tool_probes(tool_probes: ToolProbesDep) -> list[dict]:
 
 
 @router.get("/tool-probes/{n}", name="api_tool_probe_get")
-def get_tool_probe(n: int, tool_probes: ToolProbesDep) -> dict:
+def get_tool_probe(n: ProbeNumber, tool_probes: ToolProbesDep) -> dict:
     return tool_probes.get(n)
 
 
 @router.put("/tool-probes/{n}", name="api_tool_probe_put", dependencies=[needs("probe_data")])
-def put_tool_probe(n: int, body: JsonObject, tool_probes: ToolProbesDep) -> dict:
+def put_tool_probe(n: ProbeNumber, body: JsonObject, tool_probes: ToolProbesDep) -> dict:
     return tool_probes.put(n, body)
 
 

@@ -4,14 +4,19 @@ from __future__ import annotations
 
 from typing import Annotated, Any
 
-from fastapi import APIRouter, Body, Request
+from fastapi import APIRouter, Body, Path, Query, Request
 from fastapi.responses import JSONResponse
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictInt
 
 from app.access.deps import needs, require_measurement
 from app.deps import WorkflowDep
+from app.workflow.tasks import MAX_FIT_POINTS, TASKS
 
 router = APIRouter(prefix="/measure", tags=["measure"])
+# the schema names what the workflow takes (issue 25 item 7): the registry's task names, P1..P12
+TASK_NAMES: list[Any] = sorted(TASKS)
+SessionId = Annotated[str, Path(min_length=1, max_length=64, description="the session's id (``id`` of its answer)")]
+PointNumber = Annotated[int, Path(ge=1, le=MAX_FIT_POINTS, description=f"point P1..P{MAX_FIT_POINTS} of the session's task")]
 
 
 class CreateBody(BaseModel):
@@ -26,7 +31,8 @@ class CreateBody(BaseModel):
             "dim_difference": 0.06, "safe_area": 1, "k": 3, "evnum": 10, "keep_mean": True}},
          "target": {"tool": 20, "edge": 1, "correct": "radius", "mode": "wear"}},
     ]})
-    task: str = Field(description="edge.set, edge.align, edge.distance, corner.right, corner.any, "
+    # the enum is the schema's; an unknown name is the workflow's 400 naming "task", as before
+    task: str = Field(json_schema_extra={"enum": TASK_NAMES}, description="edge.set, edge.align, edge.distance, corner.right, corner.any, "
                                   "pocket.rect, hole.1..4, spigot.rect, spigot.1..4, plane.align, "
                                   "probe.length, probe.radius, toolprobe.calibrate, tool.length, tool.diameter")
     params: dict[str, Any] = Field(default_factory=dict)
@@ -42,7 +48,7 @@ class CreateBody(BaseModel):
 class StartBody(BaseModel):
     model_config = ConfigDict(extra="forbid", json_schema_extra={"examples": [{}, {"point": 2},
                                                                               {"wait": False}]})
-    point: StrictInt | None = Field(None, ge=1, le=12, description="measure this point; default: the lowest unstored")
+    point: StrictInt | None = Field(None, ge=1, le=MAX_FIT_POINTS, description="measure this point; default: the lowest unstored")
     wait: StrictBool = Field(True, description="false: answer 202 at once; GET the session for "
                                                "``running``, ``progress`` and the ``answer``")
 
@@ -64,19 +70,20 @@ def current_session(workflow: WorkflowDep) -> dict | None:
 
 
 @router.get("/{session_id}", name="api_measure_session")
-def get_session(session_id: str, workflow: WorkflowDep) -> dict:
+def get_session(session_id: SessionId, workflow: WorkflowDep) -> dict:
     return workflow.get(session_id).to_api()
 
 
 @router.get("/{session_id}/plan", name="api_measure_plan")
-def plan(session_id: str, workflow: WorkflowDep, point: int | None = None) -> dict:
+def plan(session_id: SessionId, workflow: WorkflowDep, point: Annotated[int | None, Query(
+         ge=1, le=MAX_FIT_POINTS, description="the point (default: the next unstored)")] = None) -> dict:
     """The planned path of a point from where the probe stands, with the start guard's verdict per
     segment (``clear``, ``collision``, ``limit``, ``unknown``; probing moves ``contact``/``no_switch``)."""
     return workflow.plan(session_id, point)
 
 
 @router.post("/{session_id}/start", name="api_measure_start", dependencies=[needs("measure")])
-def nc_start(request: Request, session_id: str, workflow: WorkflowDep,
+def nc_start(request: Request, session_id: SessionId, workflow: WorkflowDep,
              body: Annotated[StartBody | None, Body()] = None):
     """NC Start: probe the next unstored point (single-point tasks also compute and correct).
 
@@ -89,18 +96,18 @@ def nc_start(request: Request, session_id: str, workflow: WorkflowDep,
 
 
 @router.post("/{session_id}/points/{n}/invalidate", name="api_measure_invalidate", dependencies=[needs("measure")])
-def invalidate(session_id: str, n: int, workflow: WorkflowDep) -> dict:
+def invalidate(session_id: SessionId, n: PointNumber, workflow: WorkflowDep) -> dict:
     return workflow.invalidate(session_id, n).to_api()
 
 
 @router.post("/{session_id}/calculate", name="api_measure_calculate", dependencies=[needs("measure")])
-def calculate(request: Request, session_id: str, workflow: WorkflowDep) -> dict:
+def calculate(request: Request, session_id: SessionId, workflow: WorkflowDep) -> dict:
     session = workflow.get(session_id)
     require_measurement(request, session.task, session.target)
     return workflow.calculate(session_id)
 
 
 @router.delete("/{session_id}", name="api_measure_delete", dependencies=[needs("measure")])
-def leave(session_id: str, workflow: WorkflowDep) -> dict:
+def leave(session_id: SessionId, workflow: WorkflowDep) -> dict:
     workflow.delete(session_id)
     return {"deleted": session_id}

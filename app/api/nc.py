@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any
 
-from fastapi import APIRouter, Body, Query, Request
+from fastapi import APIRouter, Body, Path, Query, Request
 from fastapi.responses import JSONResponse
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictStr
 
@@ -125,7 +125,7 @@ def variables(nc: NcDep, names: Annotated[str, Query(description="comma-separate
 
 
 @router.put("/variables/{name}", name="api_nc_variable_put", dependencies=[needs("measure")])
-def put_variable(name: str, body: VariableBody, nc: NcDep, request: Request) -> dict:
+def put_variable(name: Annotated[str, Path(min_length=1, max_length=64, description="R1, _EV[9], _TUL")], body: VariableBody, nc: NcDep, request: Request) -> dict:
     """Write one variable element (``R1``, ``_EV[9]``, ``_TUL``) as a program would; the EV/MV
     memories need the level of ``/api/memories`` (``app.services.nc.PROTECTED``)."""
     function = protected_function(name)

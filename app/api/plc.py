@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
-from fastapi import APIRouter
+from typing import Annotated
+
+from fastapi import APIRouter, Query
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictInt
 
 from app.access.deps import needs
 from app.deps import ServicesDep
 from app.services.plc import PlcSimulator
 from app.services.readiness import ReadinessService
+from app.workflow.tasks import TASKS
 
 router = APIRouter(tags=["plc"])
 
@@ -46,6 +49,7 @@ def set_mode(body: ModeBody, services: ServicesDep) -> dict:
 
 
 @router.get("/readiness", name="api_readiness")
-def readiness(services: ServicesDep, task: str | None = None) -> dict:
+def readiness(services: ServicesDep, task: Annotated[str | None, Query(
+        json_schema_extra={"enum": sorted(TASKS)}, description="a measuring task's name")] = None) -> dict:
     """Prerequisites checklist; with ``?task=`` also whether that task is ready and what blocks it."""
     return ReadinessService(services).report(task)

@@ -5,14 +5,16 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from fastapi import APIRouter, Body
+from fastapi import APIRouter, Body, Path
 from pydantic import BaseModel, ConfigDict, Field, StrictFloat
 
 from app.access.deps import needs
 from app.deps import ProbeHealthDep, ProbeTestDep
+from app.records import MAX_PROBE
 from app.services.probe_test import DEFAULT_TIMEOUT_S, MAX_TIMEOUT_S
 
 router = APIRouter(tags=["probes"])
+ProbeNumber = Annotated[int, Path(ge=1, le=MAX_PROBE, description=f"probe record number, 1..{MAX_PROBE}")]
 
 
 class ProbeTestBody(BaseModel):
@@ -44,7 +46,7 @@ def cancel_probe_test(probe_test: ProbeTestDep) -> dict:
 
 
 @router.post("/probes/{n}/repeatability", name="api_probe_repeatability", dependencies=[needs("measure")])
-def probe_repeatability(n: int, health: ProbeHealthDep, body: Annotated[dict | None, Body()] = None) -> dict:
+def probe_repeatability(n: ProbeNumber, health: ProbeHealthDep, body: Annotated[dict | None, Body()] = None) -> dict:
     """Repeatability check (design.md §10.4, ISO 230-10 §7.1): from the current position the probe
     finds the face ahead (``direction`` "X+" … "Z-", default "Z-"; or ``directions``, e.g. the four
     of a ring gauge from its centre), then probes it ``touches`` times (default 10) from
@@ -55,6 +57,6 @@ def probe_repeatability(n: int, health: ProbeHealthDep, body: Annotated[dict | N
 
 
 @router.get("/probes/{n}/history", name="api_probe_history")
-def probe_history(n: int, health: ProbeHealthDep, probe: Literal["workpiece", "tool"] = "workpiece") -> list[dict]:
+def probe_history(n: ProbeNumber, health: ProbeHealthDep, probe: Literal["workpiece", "tool"] = "workpiece") -> list[dict]:
     """The record's calibrations, repeatability checks and invalidations, newest first."""
     return health.history(probe, n)

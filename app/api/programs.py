@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
-from fastapi import APIRouter, Response
+from typing import Annotated
+
+from fastapi import APIRouter, Path, Response
 from pydantic import BaseModel, ConfigDict, Field, StrictStr
 
 from app.access.deps import needs
 from app.deps import ProgramsDep
+from app.services.nc import PROGRAM_NAME
+
+ProgramName = Annotated[str, Path(pattern=PROGRAM_NAME.pattern, description="1..32 letters, digits or _, starting with a letter")]
 
 router = APIRouter(prefix="/programs", tags=["programs"])
 
@@ -36,12 +41,12 @@ def create_program(body: ProgramBody, programs: ProgramsDep) -> dict:
 
 
 @router.get("/{name}", name="api_program_get")
-def get_program(name: str, programs: ProgramsDep) -> dict:
+def get_program(name: ProgramName, programs: ProgramsDep) -> dict:
     return programs.get(name)
 
 
 @router.put("/{name}", name="api_program_put", dependencies=[needs("measure")])
-def put_program(name: str, body: TextBody, programs: ProgramsDep, response: Response) -> dict:
+def put_program(name: ProgramName, body: TextBody, programs: ProgramsDep, response: Response) -> dict:
     """Replace (or create: 201) the program's text; refused while it runs in the channel."""
     program, created = programs.put(name, body.text)
     if created:
@@ -50,5 +55,5 @@ def put_program(name: str, body: TextBody, programs: ProgramsDep, response: Resp
 
 
 @router.delete("/{name}", status_code=204, name="api_program_delete", dependencies=[needs("measure")])
-def delete_program(name: str, programs: ProgramsDep) -> None:
+def delete_program(name: ProgramName, programs: ProgramsDep) -> None:
     programs.delete(name)

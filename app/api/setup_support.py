@@ -3,7 +3,9 @@ NC Start (carry it out) and ``<<`` (leave without activating)."""
 
 from __future__ import annotations
 
-from fastapi import APIRouter
+from typing import Annotated
+
+from fastapi import APIRouter, Path
 from pydantic import BaseModel, ConfigDict, Field
 
 from app.access.deps import needs
@@ -22,13 +24,13 @@ class CarryOutBody(BaseModel):
 
 
 @router.get("/{session_id}/setup-support", name="api_setup_support")
-def setup_support_screen(session_id: str, services: ServicesDep, workflow: WorkflowDep) -> dict:
+def setup_support_screen(session_id: Annotated[str, Path(min_length=1, max_length=64)], services: ServicesDep, workflow: WorkflowDep) -> dict:
     """The activation screen: results, corrected WO, toggle fields, texts."""
     return setup_support.screen_model(workflow, services.machine, session_id)
 
 
 @router.post("/{session_id}/setup-support", name="api_setup_support_carry_out", dependencies=[needs("jog")])
-def carry_out(session_id: str, services: ServicesDep, workflow: WorkflowDep,
+def carry_out(session_id: Annotated[str, Path(min_length=1, max_length=64)], services: ServicesDep, workflow: WorkflowDep,
               body: CarryOutBody | None = None) -> dict:
     """NC Start on the activation screen."""
     choices = setup_support.Choices(**(body or CarryOutBody()).model_dump())
@@ -36,6 +38,6 @@ def carry_out(session_id: str, services: ServicesDep, workflow: WorkflowDep,
 
 
 @router.delete("/{session_id}/setup-support", name="api_setup_support_leave", dependencies=[needs("measure")])
-def leave(session_id: str, workflow: WorkflowDep) -> dict:
+def leave(session_id: Annotated[str, Path(min_length=1, max_length=64)], workflow: WorkflowDep) -> dict:
     """``<<``: leave without activating (the written correction stays)."""
     return setup_support.leave(workflow, session_id)

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import asyncio
 import logging
-import math
 from collections.abc import Awaitable, Callable
 
 from asyncua import ua
@@ -85,9 +84,9 @@ class GuardedAttributeService(AttributeService):
         variant = item.Value.Value if item.Value is not None else None
         if variant is None or variant.VariantType not in NUMBER_TYPES or variant.is_array:
             return status(ua.StatusCodes.BadTypeMismatch)
-        value = float(variant.Value)
-        if not math.isfinite(value):
-            return status(ua.StatusCodes.BadOutOfRange)
+        # the number as sent (an int of any size, a float, NaN): the offsets service checks it with
+        # the JSON API's validator (app/checks.py: finite, within the range) -> BadOutOfRange
+        value = variant.Value
         name, part, axis = target
         try:
             after = await asyncio.to_thread(self._put, user.name, name, part, axis, value)
@@ -100,7 +99,7 @@ class GuardedAttributeService(AttributeService):
         await self._written(name, after)
         return status(ua.StatusCodes.Good)
 
-    def _put(self, user: str, name: str, part: str, axis: str, value: float) -> dict:
+    def _put(self, user: str, name: str, part: str, axis: str, value: int | float) -> dict:
         """In a worker thread, as the user (the audit row names them)."""
         identity = self._access.user_identity(user)
         if identity is None:                       # deleted since the session began

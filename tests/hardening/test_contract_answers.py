@@ -20,3 +20,62 @@ def test_an_empty_bearer_is_still_refused_with_sign_in_on(app, client):
     app.state.access.add_user("anna", 3, "anna-pw-333")
     answer = client.get("/api/machine", headers={"Authorization": "Bearer "})
     assert answer.status_code == 401
+
+
+def test_a_405_names_every_method_of_the_path(client):
+    """FastAPI keeps one route per method: the Allow of a 405 names them all, not the first one's."""
+    answer = client.request("PATCH", "/api/tools/3")
+    assert answer.status_code == 405
+    assert set(answer.headers["Allow"].replace(" ", "").split(",")) == {"GET", "PUT", "DELETE"}
+    answer = client.request("OPTIONS", "/api/job")
+    assert set(answer.headers["Allow"].replace(" ", "").split(",")) == {"GET", "PUT", "DELETE"}
+
+
+def _parameter(schema: dict, method: str, path: str, name: str) -> dict:
+    for parameter in schema["paths"][path][method]["parameters"]:
+        if parameter["name"] == name:
+            return parameter["schema"]
+    raise AssertionError(f"{method.upper()} {path} has no parameter {name}")
+
+
+def _bounds(parameter: dict) -> tuple:
+    options = parameter.get("anyOf", [parameter])
+    number = next(o for o in options if o.get("type") == "integer")
+    return number.get("minimum"), number.get("maximum")
+
+
+def test_the_schema_bounds_the_numbers_a_path_or_query_names(app):
+    """schemathesis ST202/ST201 (issue 25 item 7): the schema states the ranges the services check
+    (tool numbers 1..9999, probe records 1..99, points P1..P12), so a schema-valid number is taken
+    and the test below shows that one outside is refused."""
+    schema = app.openapi()
+    for method in ("get", "put", "delete"):
+        assert _bounds(_parameter(schema, method, "/api/tools/{t}", "t")) == (1, 9999)
+    for method, path in [("get", "/api/probes/{n}"), ("put", "/api/probes/{n}"), ("get", "/api/tool-probes/{n}"),
+                         ("put", "/api/tool-probes/{n}"), ("post", "/api/probes/{n}/repeatability"),
+                         ("get", "/api/probes/{n}/history")]:
+        assert _bounds(_parameter(schema, method, path, "n")) == (1, 99), path
+    assert _bounds(_parameter(schema, "post", "/api/measure/{session_id}/points/{n}/invalidate", "n")) == (1, 12)
+    assert _bounds(_parameter(schema, "get", "/api/measure/{session_id}/plan", "point")) == (1, 12)
+
+
+def test_the_schema_names_the_tasks_of_the_registry(app):
+    from app.workflow.tasks import TASKS
+
+    schema = app.openapi()
+    readiness = _parameter(schema, "get", "/api/readiness", "task")
+    assert set(readiness["enum"]) == set(TASKS) and "hole.1" in readiness["enum"]
+    body = schema["components"]["schemas"]["CreateBody"]["properties"]["task"]
+    assert set(body["enum"]) == set(TASKS)
+
+
+def test_what_the_schema_refuses_the_api_refuses(client):
+    """The bounds are the services' own: outside them a 422 naming the parameter, nothing stored."""
+    for method, url, field in [("put", "/api/tools/0", "t"), ("put", "/api/tools/10000", "t"),
+                               ("get", "/api/probes/100", "n"), ("get", "/api/tool-probes/0", "n"),
+                               ("get", "/api/probes/100/history", "n"), ("get", "/api/readiness?task=nope", "task")]:
+        answer = client.request(method.upper(), url, json={"length": 1.0} if method == "put" else None)
+        assert answer.status_code == 422, (url, answer.text)
+        assert answer.json()["error"]["field"] == field, url
+    assert client.get("/api/tools/10000").status_code == 422
+    assert 10000 not in [tool["t"] for tool in client.get("/api/tools").json()]

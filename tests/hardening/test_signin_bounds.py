@@ -170,6 +170,56 @@ def test_a_flood_of_wrong_sign_ins_is_bounded_and_reset_and_jog_still_answer(app
     assert now["most"] == gate.workers and now["runs"] == codes.count(401)
 
 
+def _form_token(client) -> str:
+    """The CSRF field of the sign-in form (its cookie is now set on the client)."""
+    return re.search(r'name="csrftoken" value="([^"]+)"', client.get("/signin").text).group(1)
+
+
+def test_a_flood_of_the_sign_in_form_is_refused_early_as_the_json_sign_in(app, anna, monkeypatch):
+    """The HTML form (POST /signin) shares the bounded pool of POST /api/session: beyond the
+    workers and the queue a try is answered 429 at once, before any password work and without a
+    worker thread (the refusal runs on the event loop), and the machine calls still answer."""
+    import app.web.signin as signin_screen
+
+    release = threading.Event()
+    verify = anna._hasher.verify_and_update
+    monkeypatch.setattr(anna._hasher, "verify_and_update",
+                        lambda password, hashed: (release.wait(60), verify(password, hashed))[1])
+    threaded = []
+    to_thread = signin_screen.run_in_threadpool
+
+    async def counted(function, *args):
+        threaded.append(args[2])                          # the user name of a check that got a thread
+        return await to_thread(function, *args)
+
+    monkeypatch.setattr(signin_screen, "run_in_threadpool", counted)
+    gate = anna.gate
+    token, _record = anna.add_token("mes", 1)
+    machine = {"Authorization": f"Bearer {token}"}
+    with TestClient(app) as client, ThreadPoolExecutor(64) as pool:
+        csrf = _form_token(client)
+
+        def submit(n):
+            return client.post("/signin", data={"user": "anna", "password": f"wrong-{n}", "csrftoken": csrf},
+                               follow_redirects=False)
+
+        flood = [pool.submit(submit, n) for n in range(200)]
+        wait_until(lambda: sum(f.done() for f in flood) == 200 - gate.workers - gate.queue,
+                   "all but the admitted form sign-ins answered")
+        assert client.get("/api/machine", headers=machine).status_code == 200
+        assert client.post("/api/machine/reset", headers=machine).status_code == 200
+        busy = [f.result() for f in flood if f.done()]
+        assert {r.status_code for r in busy} == {429}
+        assert all(r.headers["Retry-After"] == "1" for r in busy)
+        assert all('id="signin-error"' in r.text and "too many sign-ins at once" in r.text for r in busy)
+        # the refused ones never got a thread: only the admitted checks (and a few that came
+        # while a slot was free for a moment) did
+        assert len(threaded) <= 200 - len(busy) + gate.workers
+        release.set()
+        answers = [f.result(timeout=60) for f in flood]
+    assert {r.status_code for r in answers} == {401, 429}
+
+
 def test_an_attackers_failures_do_not_lock_the_user_out_from_another_computer(app, anna):
     with TestClient(app, client=("192.0.2.66", 40000), base_url=LOCAL) as attacker, \
             TestClient(app, client=("198.51.100.20", 40001), base_url=LOCAL) as setter:

@@ -117,6 +117,37 @@ def test_a_zero_offset_write_needs_a_user_with_the_level(live):
     assert (code, shown) == (ua.StatusCodes.BadOutOfRange, 12.5)
 
 
+def test_a_zero_offset_write_takes_numbers_only_as_the_json_api_does(live):
+    """issue 25 item 3: an OPC UA write goes through the JSON API's number check (app/checks.py):
+    no boolean, no text, nothing infinite or NaN, no integer beyond the range; nothing written."""
+    start = ok(live.http.get("/api/offsets/G56"))["trans"]["Z"]
+
+    async def write(variant):
+        async with opc_client(live.opc_url, "serv", USERS["serv"][0]) as (client, idx):
+            leaf = await node(client, idx, "ZeroOffsets", "G56", "Trans", "Z")
+            try:
+                await leaf.write_value(ua.DataValue(variant))
+            except ua.UaStatusCodeError as exc:
+                return exc.code
+            return ua.StatusCodes.Good
+
+    refused = {
+        "boolean": (ua.Variant(True, ua.VariantType.Boolean), ua.StatusCodes.BadTypeMismatch),
+        "text": (ua.Variant("12", ua.VariantType.String), ua.StatusCodes.BadTypeMismatch),
+        "nan": (ua.Variant(float("nan"), ua.VariantType.Double), ua.StatusCodes.BadOutOfRange),
+        "infinity": (ua.Variant(float("inf"), ua.VariantType.Double), ua.StatusCodes.BadOutOfRange),
+        "1e300": (ua.Variant(1e300, ua.VariantType.Double), ua.StatusCodes.BadOutOfRange),
+        "UInt64 max": (ua.Variant(2**64 - 1, ua.VariantType.UInt64), ua.StatusCodes.BadOutOfRange),
+        "Int64 min": (ua.Variant(-2**63, ua.VariantType.Int64), ua.StatusCodes.BadOutOfRange),
+    }
+    answers = {what: run(write(variant)) for what, (variant, _code) in refused.items()}
+    assert answers == {what: code for what, (_variant, code) in refused.items()}
+    assert ok(live.http.get("/api/offsets/G56"))["trans"]["Z"] == start
+    # a whole number within the range is a number: stored as the float it is
+    assert run(write(ua.Variant(-42, ua.VariantType.Int32))) == ua.StatusCodes.Good
+    assert ok(live.http.get("/api/offsets/G56"))["trans"]["Z"] == -42.0
+
+
 def test_a_wrong_password_gets_no_session(live):
     async def connect():
         async with opc_client(live.opc_url, "serv", "not-the-password"):
