@@ -212,12 +212,16 @@ def test_a_flood_of_the_sign_in_form_is_refused_early_as_the_json_sign_in(app, a
         assert {r.status_code for r in busy} == {429}
         assert all(r.headers["Retry-After"] == "1" for r in busy)
         assert all('id="signin-error"' in r.text and "too many sign-ins at once" in r.text for r in busy)
-        # the refused ones never got a thread: only the admitted checks (and a few that came
-        # while a slot was free for a moment) did
-        assert len(threaded) <= 200 - len(busy) + gate.workers
+        # most were refused without a thread: the look-ahead on the event loop lets through only
+        # the first of the burst, before the first checks were admitted (those are refused by the
+        # pool itself, again before any password work)
+        assert len(threaded) < 50
         release.set()
         answers = [f.result(timeout=60) for f in flood]
-    assert {r.status_code for r in answers} == {401, 429}
+    codes = [r.status_code for r in answers]
+    assert set(codes) == {401, 429}
+    # argon2 ran for the admitted ones only, one at a time (as for the JSON sign-in above)
+    assert gate.free_failures <= codes.count(401) <= gate.free_failures + gate.workers
 
 
 def test_an_attackers_failures_do_not_lock_the_user_out_from_another_computer(app, anna):
