@@ -156,3 +156,42 @@ def test_lathe_tasks_from_above_and_from_the_far_side(lathe, case):
     assert answer.status_code == 200, answer.text
     result = answer.json()["result"]
     assert result.get("diameter", result["actual"]) == pytest.approx(outcome, abs=1e-6)
+
+
+# --- property: on the lathe too the guard refuses exactly what the simulator collides on ------------
+
+LATHE_COUNTS: dict[str, dict[str, int]] = {}
+
+
+def _random_start(rng, case: str) -> tuple[str, dict, float, float]:
+    if case == "X":          # above or below the turning centre, over the shaft
+        side = 1.0 if rng.uniform() < 0.5 else -1.0
+        return "lathe.point", {"axis": "X", "setpoint": 45, "measuring_path": 2}, \
+            side * float(rng.uniform(ABOVE_D, ABOVE_D + 20.0)), float(rng.uniform(15.0, 55.0))
+    # Z: in front of the face, anywhere from inside the bore to beyond the outer diameter
+    return "lathe.point", {"axis": "Z", "setpoint": 60, "measuring_path": 2}, \
+        float(rng.uniform(5.0, 70.0)), float(rng.uniform(60.0 + BALL_R + 0.5, 75.0))
+
+
+@pytest.mark.parametrize("case", ["X", "Z"])
+def test_lathe_guard_refuses_exactly_what_the_simulator_collides_on(lathe, case):
+    import numpy as np
+    from lathe_kit import LATHE_SCENARIO
+
+    rng = np.random.default_rng(24 + ord(case))
+    counts = LATHE_COUNTS.setdefault(case, {"refused": 0, "agreed": 0, "trials": 0})
+    for _ in range(10):
+        task, params, x, z = _random_start(rng, case)
+        lathe.ok(lathe.c.post("/api/sim/scenario", json=LATHE_SCENARIO))     # a fresh machine (no broken probe)
+        lathe.calibrate_probe_in_groove()
+        _probe_to(lathe, x, z)
+        session = lathe.ok(lathe.c.post("/api/measure", json={"task": task, "params": {**params, "guard": False}}))
+        plan = lathe.ok(lathe.c.get(f"/api/measure/{session['id']}/plan"))
+        refused = plan["verdict"] == "refused"
+        answer = lathe.c.post(f"/api/measure/{session['id']}/start", json={})
+        collided = answer.status_code == 409 and "61302" in answer.json()["error"]["message"]
+        counts["trials"] += 1
+        counts["refused"] += int(refused)
+        assert refused == collided, (task, params, x, z, plan, answer.text)
+        counts["agreed"] += 1
+    print(f"lathe start guard {case}: {counts}")
