@@ -60,3 +60,17 @@ def test_fullwidth_digits_are_refused_before_anything_moves(client):
     assert answer.status_code == 422, answer.text
     assert (answer.json()["error"]["line"], answer.json()["error"]["column"]) == (1, 9)
     assert mcs(client) == before
+
+
+def test_a_stored_program_with_a_fullwidth_digit_shows_the_alarm_and_does_not_start(client):
+    """The same ASCII rule for a stored program: saved with its syntax alarm (12080, line and
+    column of the character), refused at NC Start with nothing moved."""
+    stored = client.post("/api/programs", json={"name": "FW", "text": "G91\nG0 Z１\nM30"})
+    assert stored.status_code == 201, stored.text
+    assert (stored.json()["syntax"]["code"], stored.json()["syntax"]["line"], stored.json()["syntax"]["column"]) \
+        == (12080, 2, 5)
+    before = mcs(client)
+    answer = client.post("/api/nc/run", json={"program": "FW"})
+    assert answer.status_code == 422 and answer.json()["error"]["code"] == "nc_syntax"
+    assert answer.json()["error"]["alarm"]["code"] == 12080 and "U+FF11" in answer.json()["error"]["message"]
+    assert mcs(client) == before
