@@ -39,7 +39,7 @@ def lathe(lathe_server):
 
 @pytest.fixture
 def tab(browser, lathe_server):
-    with browser_tab(browser, lathe_server) as page:
+    with browser_tab(browser, lathe_server, timeout_ms=15000) as page:
         yield page
 
 
@@ -285,3 +285,17 @@ def test_lathe_results_in_the_operators_language(tab, lathe):
     for english in ("Trigger", "Position deviation", "Effective", "Written"):
         expect(box).not_to_contain_text(english)
     expect(tab.locator("#task-svg figcaption").first).to_contain_text("Reale Aufspannung")
+
+
+def test_the_feed_unit_whole_in_inch_and_chinese(tab, lathe):
+    """Chinese with inch (issue 29): the feed's unit reads inch/min on one line, nothing cut."""
+    assert lathe.c.put("/api/settings", json={"units": "inch"}).status_code == 200
+    try:
+        tab.set_viewport_size({"width": 1024, "height": 768})
+        tab.goto("/jog?lang=zh")
+        tab.goto("/measure/lathe/twopoint")
+        unit = tab.locator('[data-field="feed"] .unit')
+        expect(unit).to_have_text("inch/min")
+        assert unit.evaluate("e => e.scrollWidth <= e.clientWidth + 1 && e.getBoundingClientRect().height < 20")
+    finally:
+        assert lathe.c.put("/api/settings", json={"units": "mm"}).status_code == 200
