@@ -47,7 +47,7 @@ def as_anna(page) -> None:
 
 
 def test_a_calibration_screen_opened_by_address_shows_its_lock(browser, locked_server):
-    with browser_tab(browser, locked_server) as page:
+    with browser_tab(browser, locked_server, timeout_ms=15000) as page:
         at_the_panel(page)
         starts = []
         page.on("request", lambda r: starts.append(r.url) if "/measure/task/" in r.url and r.url.endswith("/start")
@@ -76,7 +76,7 @@ def test_a_calibration_screen_opened_by_address_shows_its_lock(browser, locked_s
 
 
 def test_the_lock_in_german(browser, locked_server):
-    with browser_tab(browser, locked_server) as page:
+    with browser_tab(browser, locked_server, timeout_ms=15000) as page:
         at_the_panel(page, "de")
         page.goto("/measure/workpiece/calibrate/radius")
         lock = page.locator("#start-lock")
@@ -92,7 +92,7 @@ def test_the_lock_in_german(browser, locked_server):
 
 
 def test_a_level_that_may_calibrate_has_no_lock(browser, locked_server):
-    with browser_tab(browser, locked_server) as page:
+    with browser_tab(browser, locked_server, timeout_ms=15000) as page:
         as_anna(page)
         page.goto("/measure/workpiece/calibrate/length")
         expect(page.locator("#screen")).to_have_attribute("data-screen", "measure_workpiece")
@@ -101,7 +101,7 @@ def test_a_level_that_may_calibrate_has_no_lock(browser, locked_server):
 
 
 def test_forms_are_read_only_when_save_is_not_allowed(browser, locked_server):
-    with browser_tab(browser, locked_server) as page:
+    with browser_tab(browser, locked_server, timeout_ms=15000) as page:
         at_the_panel(page)
         page.goto("/settings")
         expect(page.locator('#vsoftkeys [data-key="S-F1"]')).to_be_disabled()
@@ -118,7 +118,7 @@ def test_forms_are_read_only_when_save_is_not_allowed(browser, locked_server):
             assert inputs.count() > 3, url
             for i in range(inputs.count()):
                 expect(inputs.nth(i)).to_be_disabled()
-    with browser_tab(browser, locked_server) as page:
+    with browser_tab(browser, locked_server, timeout_ms=15000) as page:
         as_anna(page)                                         # level 3: Save allowed, the fields editable
         page.goto("/settings")
         expect(page.locator("#settings-read-only")).to_have_count(0)
