@@ -89,6 +89,10 @@ def test_the_lock_in_german(browser, locked_server):
         expect(save.locator(".why")).to_have_text("erfordert Stufe 3")
         expect(save).to_have_attribute("title", re.compile("Schlüsselschalter|Kennwort"))
         expect(page.locator("#settings-read-only")).to_contain_text("erfordert Stufe 3")
+        page.goto("/offsets")                                 # a locked table cell says why in German
+        cell = page.locator('td[data-offset="G54"][data-field="trans.X"] input')
+        expect(cell).to_be_disabled()
+        expect(cell).to_have_attribute("title", re.compile("erfordert Stufe 5"))
 
 
 def test_a_level_that_may_calibrate_has_no_lock(browser, locked_server):
