@@ -83,11 +83,6 @@ def integer(value: Any, field: str, *, lo: int | None = None, hi: int | None = N
     return value
 
 
-def is_number_text(text: str) -> bool:
-    """``text`` is a plain number in ASCII (after removing blanks; a comma as the decimal sign)."""
-    return bool(_NUMBER_TEXT.fullmatch(normalise_number_text(text)))
-
-
 def normalise_number_text(text: Any) -> str:
     """Typed text with blanks removed, a comma or a typographic minus as the point and the sign."""
     raw = str(text if text is not None else "").strip()

@@ -20,7 +20,7 @@ the measuring feed (turning §0.8), the channel settings (turning §0.10), the p
 from __future__ import annotations
 
 import math
-from collections.abc import Generator, Iterable, Mapping, Sequence
+from collections.abc import Generator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any, TypeGuard
 
@@ -283,14 +283,6 @@ class LatheTool:
 # --- tool probe record _TP / _TPW (turning.md §0.7) ---------------------------------------------
 
 TP_KEYS = ("Z-", "Z+", "X-", "X+")    # _TP[k,0..3]: Z minus, Z plus, X minus, X plus [L25369–L25378]
-
-
-def tp_from_list(values: Iterable[float]) -> dict[str, float]:
-    """{"Z-": _TP[k,0], "Z+": [1], "X-": [2], "X+": [3]}, the turning layout [L16770–L16773]."""
-    vals = [float(v) for v in values]
-    if len(vals) < 4:
-        raise ValueError(f"a tool probe record needs _TP[k,0..3], got {len(vals)} values")
-    return dict(zip(TP_KEYS, vals[:4], strict=True))
 
 
 def tp_to_list(record: Mapping[str, float]) -> list[float]:

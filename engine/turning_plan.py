@@ -34,7 +34,6 @@ from engine.turning import (
     LathePoint,
     LatheProgram,
     LatheTool,
-    is_diameter,
 )
 from engine.turning_mills import evaluate_mill, mill_program
 from engine.turning_offsets import ToolTarget
@@ -549,8 +548,3 @@ def lathe_planned_path(prep: LathePrep, start: npt.ArrayLike) -> list[Step]:
     with contextlib.suppress(MeasuringError):
         run_program(lathe_program(prep, start), ideal, steps)
     return steps
-
-
-def display_axes(ctx: LatheContext) -> dict[str, bool]:
-    """Which axes a screen shows as diameters for the cycle values (turning.md §0.3, turning §10.1)."""
-    return {a: is_diameter(a, ctx.diamon, a == "Y" and ctx.bit(19)) for a in ("X", "Y", "Z")}

@@ -86,12 +86,6 @@ def _axis_rotation(axis: str, deg: float) -> np.ndarray:
     return rpy_matrix(rot)
 
 
-def head_rotation(head_axes, angles_deg) -> np.ndarray:
-    """R_head = R_second(θ_second)·R_first(θ_first) (scenario.SwivelHead; axes alphabetical)."""
-    (first, second), (t1, t2) = head_axes, angles_deg
-    return _axis_rotation(second, float(t2)) @ _axis_rotation(first, float(t1))
-
-
 def head_angles_for(head_axes, n, current=(0.0, 0.0)) -> list[tuple[float, float]]:
     """All (θ_first, θ_second) in degrees with R_head·ẑ = n (unit), before limit/wrap choice.
 

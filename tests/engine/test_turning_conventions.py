@@ -21,7 +21,6 @@ from engine.turning import (
     to_display,
     to_radius,
     tool_family,
-    tp_from_list,
     tp_to_list,
 )
 from engine.turning_offsets import (
@@ -95,7 +94,6 @@ def test_parameters():
 
 def test_records():
     """§0.7: _TP[k,0..3] = Z−, Z+, X−, X+; _WP[k,0..10] turning layout."""
-    assert tp_from_list([50, 20, 70, 40]) == {"Z-": 50.0, "Z+": 20.0, "X-": 70.0, "X+": 40.0}
     assert tp_to_list({"X-": 400.25, "Z-": 220.35}) == [220.35, 0.0, 400.25, 0.0]
     values = [5.99, 2.995, -2.99, 2.991, -2.999, 2.9, -2.9, 0.001, 0.004, 0.0, 0.0]
     probe = LatheProbe.from_wp(values)

@@ -12,7 +12,6 @@ from engine.checks import ParamError
 from engine.turning import LatheContext, LatheProbe, LatheTool
 from engine.turning_plan import (
     LATHE_TASKS,
-    display_axes,
     evaluate_lathe,
     finish_lathe,
     lathe_planned_path,
@@ -247,4 +246,3 @@ def test_planned_path_preview():
     assert len([s for s in steps if s.__class__.__name__ == "ProbeStep"]) == 2
     assert steps[-1].target == pytest.approx(xz(420, 240))
     assert lathe_planned_path(prep, xz(400.5, 240)) == []
-    assert display_axes(LatheContext(diamon=True)) == {"X": True, "Y": False, "Z": False}

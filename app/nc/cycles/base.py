@@ -23,7 +23,6 @@ import numpy as np
 from app.errors import HmiError, WorkflowError
 from app.nc.interpreter import CycleContext
 from app.workflow.context import MEASURE_ONLY, MeasuringContext, MeasuringSetup
-from app.workflow.finish_tool_offset import target_label
 from app.workflow.service import WorkflowService
 from app.workflow.tasks import TaskSpec
 from engine import alarms
@@ -367,10 +366,6 @@ def _tool_knum_digits(knum: int) -> tuple[int, int, int]:
         raise CycleAlarm(alarms.KNUM_DIGIT7, f"_KNUM={knum}: setup/sum offsets and tool environments "
                          "(7th digit) are not supported")
     return d, kind, which
-
-
-def describe_target(target) -> str:
-    return target_label(target) if isinstance(target, dict) else str(target)
 
 
 def run_cycle(ctx: CycleContext, host: CycleHost, number: int, body: Callable[[Call], None]) -> None:
