@@ -12,13 +12,24 @@ import threading
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from alembic import command
 from alembic.config import Config
 from alembic.runtime.migration import MigrationContext
 from alembic.script import ScriptDirectory
-from sqlalchemy import URL, Connection, Engine, bindparam, create_engine, event, make_url, select, update
+from sqlalchemy import (
+    URL,
+    Connection,
+    Engine,
+    Table,
+    bindparam,
+    create_engine,
+    event,
+    make_url,
+    select,
+    update,
+)
 from sqlalchemy.exc import DBAPIError, OperationalError
 from sqlalchemy.orm import Session
 from sqlalchemy.pool import ConnectionPoolEntry, NullPool
@@ -366,7 +377,7 @@ _PATH = re.compile(r"(?:[A-Za-z]:)?(?:[\\/][^\s\\/:\"']+){2,}[\\/]?")
 
 
 # a writing unit raises the write count (prepared once: Core, no ORM synchronisation)
-_MACHINES = Machine.__table__
+_MACHINES = cast(Table, Machine.__table__)
 _COUNT_WRITE = (update(_MACHINES).where(_MACHINES.c.name == bindparam("machine"))
                 .values(writes=_MACHINES.c.writes + 1, last_seen=bindparam("now")))
 _WRITE_COUNT_SQL = (f"SELECT {Machine.__table__.c.writes.name} FROM {Machine.__tablename__} "

@@ -14,9 +14,9 @@ from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import dataclass
 from datetime import UTC, datetime
-from typing import Any, TypeVar
+from typing import Any, TypeVar, cast
 
-from sqlalchemy import Row, bindparam, delete, exists, func, insert, select
+from sqlalchemy import Insert, Row, Table, bindparam, delete, exists, func, insert, select
 from sqlalchemy.orm import Session
 
 from db.models import (
@@ -215,11 +215,13 @@ class Unit(PartsUnit, PlantUnit, ProbeEventsUnit):
             "before": _json_ready(before, "before"), "after": _json_ready(after, "after"), "source": str(source),
             "detail": _json_ready(detail, "detail"), "who": actor.who[:80], "who_level": actor.level})
 
-    def _insert(self, statement, values: dict[str, Any]) -> int:
+    def _insert(self, statement: Insert, values: dict[str, Any]) -> int:
         """One row by a prepared INSERT (no unit-of-work bookkeeping for a row nobody changes
         afterwards in the transaction); what the session holds is written before it, in order."""
         self._session.flush()
-        return int(self._session.connection().execute(statement, values).inserted_primary_key[0])
+        key = self._session.connection().execute(statement, values).inserted_primary_key
+        assert key is not None                 # an INSERT of one row always has its key
+        return int(key[0])
 
     def audit(self, limit: int = 200, name: str | None = None, kind: str | None = None,
               before_id: int | None = None) -> list[dict[str, Any]]:
@@ -588,8 +590,8 @@ class _EndedTransaction:
 # prepared once (building a statement costs more than running it): the rows a measurement writes
 _FRAME_ROWS = select(FrameAxis).where(FrameAxis.machine == bindparam("machine"), FrameAxis.channel == CHANNEL,
                                       FrameAxis.name == bindparam("name"))
-_AUDIT_INSERT = insert(OffsetAudit.__table__)
-_LOG_INSERT = insert(MeasurementLog.__table__)
+_AUDIT_INSERT = insert(cast(Table, OffsetAudit.__table__))
+_LOG_INSERT = insert(cast(Table, MeasurementLog.__table__))
 
 
 def _new_frame_axis(slot: OffsetSlot, axis: str, machine: str) -> FrameAxis:

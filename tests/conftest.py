@@ -25,12 +25,19 @@ def pytest_configure(config):
     config.addinivalue_line("markers", "sqlite_only: reads the SQLite file itself (skipped on PostgreSQL)")
 
 
+@pytest.hookimpl(tryfirst=True)     # before pytest-xdist reads the groups
 def pytest_collection_modifyitems(config, items):
     if config.getoption("--db-engine") == "postgresql":
         skip = pytest.mark.skip(reason="reads the SQLite file itself")
         for item in items:
             if "sqlite_only" in item.keywords:
                 item.add_marker(skip)
+    # one LinuxCNC at a time on a computer (/tmp/linuxcnc.lock, its shared memory): with pytest-xdist
+    # (scripts/test.sh, --dist loadgroup) every test that starts one runs on the same worker
+    for item in items:
+        if (item.nodeid.startswith("tests/linuxcnc/") or "[linuxcnc" in item.nodeid
+                or item.get_closest_marker("linuxcnc") is not None):
+            item.add_marker(pytest.mark.xdist_group("linuxcnc"))
 
 
 @pytest.fixture(scope="session")

@@ -47,7 +47,7 @@ async def position(request: Request):
            request.scope.get("root_path", ""))
     cache = getattr(request.app.state, "position_cache", None)
     if cache is None or cache[0] is not snapshot or not (cache[1] is gud or cache[1] == gud) or len(cache[2]) > 64:
-        cache = (snapshot, gud, {})
+        cache = (snapshot, gud, dict[tuple, bytes]())
         request.app.state.position_cache = cache
     body = cache[2].get(key)
     if body is None:

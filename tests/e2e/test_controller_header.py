@@ -25,6 +25,7 @@ def test_the_simulator_is_named_with_its_trainer_banner(page, api):
     expect(page.locator("#trainer-banner")).to_be_visible()
 
 
+@pytest.mark.linuxcnc
 def test_the_machines_own_linuxcnc_is_named_and_its_e_stop_shown(browser, tmp_path, monkeypatch):
     from app.machine.linuxcnc.modules import available
 
