@@ -116,6 +116,14 @@ def trusted_hosts(settings: Settings) -> list[str]:
     return list(dict.fromkeys(name.lower() for name in names))
 
 
+def _flat_routes(app: FastAPI) -> list:
+    """Every route, the ones of lazily included routers too (FastAPI >= 0.16x keeps those apart)."""
+    import fastapi.routing
+
+    flatten = getattr(fastapi.routing, "iter_route_contexts", None)
+    return list(flatten(app.routes)) if flatten else list(app.routes)
+
+
 def create_app(settings: Settings | None = None) -> FastAPI:
     settings = settings or Settings()
     scenario = read_scenario(settings)
@@ -162,8 +170,9 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(api_router)
     app.include_router(web_router)
     app.mount("/static", StaticFiles(directory=STATIC_DIR), name="static")
-    openapi_doc.install(app, public_paths={r.path for r in app.routes
-                                            if isinstance(r, Route | Mount) and r.name in PUBLIC_ROUTES})
+    openapi_doc.install(app, public_paths={r.path for r in _flat_routes(app)
+                                            if isinstance(r.route if hasattr(r, "original_route") else r, Route | Mount)
+                                            and r.name in PUBLIC_ROUTES})
     app.state.endpoints = shop_floor_endpoints(settings, services, access)
     return app
 

@@ -89,6 +89,8 @@ def rewrite(document: dict, public_paths: set[str]) -> dict:
             if method not in {"get", "put", "post", "delete", "patch"}:
                 continue
             responses = operation.setdefault("responses", {})
+            if path in public_paths:
+                operation["security"] = []          # anyone may call it, signed in or not
             for status in _statuses(method, path, path in public_paths):
                 responses[str(status)] = _error_response(status)
             _example_for(method, path, operation)

@@ -140,7 +140,7 @@ def put_settings(request: Request, body: JsonObject, settings: SettingsDep) -> d
 
 @router.get("/log", name="api_log")
 def list_log(log: LogDep, limit: Annotated[int, Query(ge=1, le=1000)] = 100,
-             offset: Annotated[int, Query(ge=0, le=2**62)] = 0) -> list[dict]:
+             offset: Annotated[int, Query(ge=0, le=2**62 - 1)] = 0) -> list[dict]:
     """The measurement log, newest first: ``limit`` entries after the newest ``offset``."""
     return log.list(limit, offset)
 

@@ -45,7 +45,8 @@ def get_program(name: ProgramName, programs: ProgramsDep) -> dict:
     return programs.get(name)
 
 
-@router.put("/{name}", name="api_program_put", dependencies=[needs("measure")])
+@router.put("/{name}", name="api_program_put", dependencies=[needs("measure")],
+            responses={201: {"description": "created: the program did not exist"}})
 def put_program(name: ProgramName, body: TextBody, programs: ProgramsDep, response: Response) -> dict:
     """Replace (or create: 201) the program's text; refused while it runs in the channel."""
     program, created = programs.put(name, body.text)

@@ -50,7 +50,8 @@ def list_parts(results: ResultsDep, part_number: Annotated[str | None, Query(max
 
 @router.get("/parts/export.dfq", name="api_parts_dfq", response_class=Response,
             responses={200: {"content": {"text/plain": {}}, "description": "AQDEF (DFQ) text, Windows-1252"}})
-def export_dfq(quality: QualityDep, part_number: Annotated[str | None, Query(max_length=64)] = None) -> Response:
+def export_dfq(quality: QualityDep, part_number: Annotated[str, Query(
+        min_length=1, max_length=64, description="the part number of the series")]) -> Response:
     """Q-DAS AQDEF (DFQ) of every part of ``part_number``: K1001/K1002 part, K1053 order,
     K2001/K2002 characteristic, K2101 nominal, K2110/K2111 limits, K2142 unit, K2022 decimals,
     per value K0001 value, K0004 date/time, K0006 serial, K0008 operator, K0012 gauge (the probe)."""
@@ -64,8 +65,10 @@ def _file_name(text: str) -> str:
 
 
 @router.get("/spc", name="api_spc")
-def spc(quality: QualityDep, part_number: Annotated[str | None, Query(max_length=64)] = None,
-        characteristic: Annotated[str | None, Query(max_length=80)] = None) -> dict:
+def spc(quality: QualityDep,
+        part_number: Annotated[str, Query(min_length=1, max_length=64, description="the part number of the series")],
+        characteristic: Annotated[str, Query(min_length=1, max_length=80, description="the name of a characteristic")]
+        ) -> dict:
     """One characteristic over the parts of ``part_number``: ``{"n", "values", "mean", "sigma",
     "ucl", "lcl", "cp", "cpk", ...}`` (individuals chart; docs/results.md) and the points of the
     run chart with the tool-offset compensations."""
