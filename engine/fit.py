@@ -394,6 +394,32 @@ def _gauss_newton(residual_jac: _ResidualJac, x0: FloatArray, scale: float) -> F
     return x
 
 
+def _sphere_points(points_3d: npt.ArrayLike, radius: float | None, has_center0: bool
+                   ) -> tuple[FloatArray, FloatArray, float, bool]:
+    """(points, points minus their mean, their extent, coplanar) of :func:`fit_sphere`, checked:
+    a given radius > 0 (61413), enough points (61317), not collinear, not coplanar unless the radius
+    and a start centre are given (61316)."""
+    pts = _as_points(points_3d, 3, "points_3d")
+    fixed = radius is not None
+    if radius is not None and not (np.isfinite(radius) and radius > 0.0):
+        raise MeasuringError(alarms.SPHERE_DIAMETER, f"sphere radius must be > 0, got {radius}")
+    need = 3 if fixed else 4
+    if len(pts) < need:
+        raise MeasuringError(alarms.CIRCLE_PARAMETERS,
+                             f"a sphere needs {need} or more points{' (radius given)' if fixed else ''}, got {len(pts)}")
+    q = pts - pts.mean(axis=0)
+    scale = _extent(q)
+    sv = np.linalg.svd(q, compute_uv=False)
+    if scale == 0.0 or sv[1] <= REL_EPS * scale:
+        raise MeasuringError(alarms.CIRCLE_UNDETERMINED, "sphere cannot be determined: points collinear")
+    coplanar = bool(sv[2] <= REL_EPS * scale)
+    if coplanar and (not fixed or not has_center0):
+        raise MeasuringError(alarms.CIRCLE_UNDETERMINED,
+                             "sphere cannot be determined: points in one plane"
+                             + (" (give center0 to choose the side)" if fixed else ""))
+    return pts, q, scale, coplanar
+
+
 def fit_sphere(points_3d: npt.ArrayLike, *, radius: float | None = None, center0: npt.ArrayLike | None = None,
                sigma: float | None = None) -> SphereFit:
     """Sphere through n points in space (measuring-math §13.2, CYCLE997).
@@ -412,26 +438,9 @@ def fit_sphere(points_3d: npt.ArrayLike, *, radius: float | None = None, center0
     """
     if sigma is not None:
         checks.real("sigma", sigma, minimum=0.0)
-    pts = _as_points(points_3d, 3, "points_3d")
+    pts, q, scale, coplanar = _sphere_points(points_3d, radius, center0 is not None)
     fixed = radius is not None
-    if radius is not None and not (np.isfinite(radius) and radius > 0.0):
-        raise MeasuringError(alarms.SPHERE_DIAMETER, f"sphere radius must be > 0, got {radius}")
-    need = 3 if fixed else 4
-    if len(pts) < need:
-        raise MeasuringError(alarms.CIRCLE_PARAMETERS,
-                             f"a sphere needs {need} or more points{' (radius given)' if fixed else ''}, got {len(pts)}")
     mean = pts.mean(axis=0)
-    q = pts - mean
-    scale = _extent(q)
-    sv = np.linalg.svd(q, compute_uv=False)
-    if scale == 0.0 or sv[1] <= REL_EPS * scale:
-        raise MeasuringError(alarms.CIRCLE_UNDETERMINED, "sphere cannot be determined: points collinear")
-    coplanar = sv[2] <= REL_EPS * scale
-    if coplanar and (not fixed or center0 is None):
-        raise MeasuringError(alarms.CIRCLE_UNDETERMINED,
-                             "sphere cannot be determined: points in one plane"
-                             + (" (give center0 to choose the side)" if fixed else ""))
-
     r_given = float("nan") if radius is None else float(radius)
 
     def free(x: FloatArray) -> tuple[FloatArray, FloatArray]:
