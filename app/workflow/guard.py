@@ -176,7 +176,9 @@ def ideal_directions(report: GuardReport) -> list[np.ndarray] | None:
     return list(report.probe_directions)
 
 
-def refusal_error(report: GuardReport, n: int, axes: tuple[str, ...], params: dict) -> GuardRefused | None:
+def refusal_error(report: GuardReport, n: int, axes: tuple[str, ...], params: dict, *,
+                  x_radius: bool = False) -> GuardRefused | None:
+    """The 409 of a refused path (None: clear). ``x_radius``: a lathe's X is a radius here."""
     seg = report.refusal
     if seg is None:
         return None
@@ -194,7 +196,7 @@ def refusal_error(report: GuardReport, n: int, axes: tuple[str, ...], params: di
         alarm = alarms.START_GUARD_COLLISION
         at = seg.where if seg.where is not None else seg.end
         where = " ".join(f"{a}{float(v):.3f}" for a, v in zip(axes, at, strict=True))
-        what = f"{label} would run into the {seg.body or 'material'} at {where} (WCS)"
+        what = f"{label} would run into the {seg.body or 'material'} at {where} (WCS{', X a radius' if x_radius else ''})"
         if "DZ" in label and params.get("infeed") is not None:
             what += f": infeed {float(params['infeed']):g} mm reaches below the {seg.body or 'feature'}"
     message = f"{alarm.number} {alarm.text}: {what}. Nothing moved."

@@ -377,7 +377,7 @@ class WorkflowService:
             raise report
         if report is None:
             return []                      # NC Start raises the program's own alarm
-        refused = guard.refusal_error(report, n, ("X", "Y", "Z"), session.params)
+        refused = guard.refusal_error(report, n, ("X", "Y", "Z"), session.params, x_radius=bool(spec.lathe))
         if refused is not None:
             raise refused
         if not guard.guarded(spec):

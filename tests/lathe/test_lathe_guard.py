@@ -149,6 +149,9 @@ def test_lathe_tasks_from_above_and_from_the_far_side(lathe, case):
         assert answer.status_code == 409, answer.text
         error = answer.json()["error"]
         assert error["code"] == "guard" if outcome == "guard" else outcome in error["message"], error
+        if outcome == "guard":       # where it would touch: the shaft's far side (its axis 0.030 off in X), a radius
+            assert f"X{-(SHAFT_D / 2 - ECCENTRICITY_X + BALL_R):.3f} " in error["message"], error
+            assert "(WCS, X a radius)" in error["message"], error
         assert state["mcs"] == before["mcs"] and not state["busy"]                    # nothing moved
         if outcome == "guard":
             assert lathe.ok(lathe.c.get("/api/log")) == log                           # nothing logged
