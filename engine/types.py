@@ -282,6 +282,14 @@ def averaged(points: Iterable[_T]) -> _T:
 
 def _mean_of(values: Sequence[Any]) -> Any:      # any field type of the stored points
     first = values[0]
+    if first is None or isinstance(first, bool | str | int | float | np.floating | np.ndarray):
+        return _mean_of_leaves(values)
+    return _mean_of_nested(values)
+
+
+def _mean_of_leaves(values: Sequence[Any]) -> Any:
+    """None; labels, keys and flags that must agree; numbers and arrays averaged."""
+    first = values[0]
     if first is None:
         return None
     if isinstance(first, bool) or isinstance(first, str | int) and not isinstance(first, float):
@@ -290,8 +298,12 @@ def _mean_of(values: Sequence[Any]) -> Any:      # any field type of the stored 
         return first
     if isinstance(first, float | np.floating):
         return float(np.mean(values))
-    if isinstance(first, np.ndarray):
-        return np.mean(np.stack([np.asarray(v, dtype=float) for v in values]), axis=0)
+    return np.mean(np.stack([np.asarray(v, dtype=float) for v in values]), axis=0)
+
+
+def _mean_of_nested(values: Sequence[Any]) -> Any:
+    """Tuples and lists (of touches), dicts and value objects, averaged field by field."""
+    first = values[0]
     if isinstance(first, tuple | list):
         if any(len(v) != len(first) for v in values):
             raise ValueError("measurements at one place have different numbers of touches")
