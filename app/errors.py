@@ -116,11 +116,14 @@ def allowed_methods(request: Request) -> list[str]:
     flatten = getattr(fastapi.routing, "iter_route_contexts", None)
     routes = flatten(request.app.router.routes) if flatten else request.app.router.routes
     path = request.scope.get("path", "")
-    methods: set[str] = set()
+    literal: set[str] = set()          # routes of this very path (``/api/measure/current``)
+    templated: set[str] = set()        # routes whose parameters match it (``/api/measure/{session_id}``)
     for route in routes:
         regex = getattr(route, "path_regex", None)
         if regex is not None and regex.match(path):
-            methods.update(getattr(route, "methods", None) or ())
+            (literal if getattr(route, "path", None) == path else templated).update(
+                getattr(route, "methods", None) or ())
+    methods = literal or templated       # the schema's path item: the literal one where there is one
     order = ("GET", "HEAD", "POST", "PUT", "PATCH", "DELETE", "OPTIONS")
     return sorted(methods, key=lambda m: (order.index(m) if m in order else len(order), m))
 

@@ -19,6 +19,7 @@ from app.deps import (
     ToolsDep,
 )
 from app.records import MAX_PROBE, MAX_TOOL
+from app.services.memories import MAX_VALUE as MEMORY_MAX
 from app.services.memories import WRITE_FUNCTION as MEMORY_WRITE
 from app.services.undo import UNDO_FUNCTION, undo
 
@@ -156,7 +157,9 @@ MemoryNumber = Annotated[int, Path(ge=1, le=20, description="memory number n of 
 
 class MemoryBody(BaseModel):
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False, json_schema_extra={"examples": [{"value": 0.004}]})
-    value: StrictFloat
+    # the range is the service's (app/services/memories.py, 422 naming "value"): stated in the schema
+    value: StrictFloat = Field(json_schema_extra={"minimum": -MEMORY_MAX, "maximum": MEMORY_MAX},
+                               description=f"mm, within ±{MEMORY_MAX:g}")
 
 
 @router.get("/memories", name="api_memories")

@@ -18,7 +18,9 @@ router = APIRouter(tags=["plc"])
 
 class BitBody(BaseModel):
     model_config = ConfigDict(extra="forbid", json_schema_extra={"examples": [{"bit": 0, "value": True}]})
-    bit: StrictInt = Field(description="0..3: request 'point bit+1 invalid' (bits 4..7 belong to the HMI)")
+    # the schema states the range; the PLC simulator's own check keeps its message for the rest
+    bit: StrictInt = Field(description="0..3: request 'point bit+1 invalid' (bits 4..7 belong to the HMI)",
+                           json_schema_extra={"minimum": 0, "maximum": 3})
     value: StrictBool
 
 

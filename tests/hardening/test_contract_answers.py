@@ -29,6 +29,12 @@ def test_a_405_names_every_method_of_the_path(client):
     assert set(answer.headers["Allow"].replace(" ", "").split(",")) == {"GET", "PUT", "DELETE"}
     answer = client.request("OPTIONS", "/api/job")
     assert set(answer.headers["Allow"].replace(" ", "").split(",")) == {"GET", "PUT", "DELETE"}
+    # a literal path names its own methods, not those of a parameter's path it also matches
+    # (/api/measure/{session_id} has DELETE, /api/measure/current only GET)
+    answer = client.request("OPTIONS", "/api/measure/current")
+    assert answer.status_code == 405 and answer.headers["Allow"] == "GET"
+    answer = client.request("OPTIONS", "/api/measure/abc123")
+    assert set(answer.headers["Allow"].replace(" ", "").split(",")) == {"GET", "DELETE"}
 
 
 def _parameter(schema: dict, method: str, path: str, name: str) -> dict:
