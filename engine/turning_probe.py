@@ -248,6 +248,19 @@ class ProbeCalibrationResult:
     ovi: tuple[int, ...]
 
 
+def _checked_diameter(d_eff: float, stored_d: float, nominal_d: float, call: Cycle973, stored: list[str]) -> float:
+    """The effective ball diameter to store (turning §0.11 rule; one never entered, 0, is checked
+    against 2·DP6 and always stored [I]); "diameter" appended to ``stored`` when it is written."""
+    if stored_d == 0.0:
+        calibration_check(d_eff, nominal_d, 0.0, call.tsa, "effective ball diameter")
+        stored.append("diameter")
+        return d_eff
+    d_out, changed = calibration_check(d_eff, stored_d, call.tzl, call.tsa, "effective ball diameter")
+    if changed:
+        stored.append("diameter")
+    return d_out
+
+
 def evaluate_probe_calibration(call: Cycle973, point: LathePoint, ctx: LatheContext) -> ProbeCalibrationResult:
     """turning.md §4.4:
 
@@ -282,7 +295,7 @@ def evaluate_probe_calibration(call: Cycle973, point: LathePoint, ctx: LatheCont
     # turning §0.11 calibration rule, every value checked before anything is stored
     stored_values: dict[str, float] = {}
     stored: list[str] = []
-    differences = {}
+    differences: dict[str, float] = {}
     for k, t in triggers.items():
         value, changed = calibration_check(t, old.trigger_value(k), call.tzl, call.tsa, f"trigger value {k}")
         stored_values[k] = value
@@ -299,15 +312,7 @@ def evaluate_probe_calibration(call: Cycle973, point: LathePoint, ctx: LatheCont
             stored.append(f"skew {c.axis}")
     d_out = old.effective_diameter
     if d_eff is not None:
-        if old.effective_diameter == 0.0:
-            calibration_check(d_eff, 2.0 * c.r, 0.0, call.tsa, "effective ball diameter")
-            d_out = d_eff
-            stored.append("diameter")
-        else:
-            d_out, changed = calibration_check(d_eff, old.effective_diameter, call.tzl, call.tsa,
-                                               "effective ball diameter")
-            if changed:
-                stored.append("diameter")
+        d_out = _checked_diameter(d_eff, old.effective_diameter, 2.0 * c.r, call, stored)
         differences["diameter"] = d_eff - (old.effective_diameter or 2.0 * c.r)
     trig = dict(old.trigger)
     trig.update(stored_values)
