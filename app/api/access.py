@@ -14,7 +14,8 @@ from app.access.errors import AccessDenied
 from app.access.identity import TRAINER
 from app.access.levels import describe_level, keyswitch_level
 from app.access.middleware import is_local
-from app.access.service import SESSION_COOKIE, AccessError, AccessService, SignInRefused
+from app.access.service import MIN_PASSWORD, SESSION_COOKIE, AccessError, AccessService, SignInRefused
+from app.access.service import NAME as USER_NAME
 from app.access.throttle import HTTP, Throttled
 from app.errors import ConflictError, HmiError, InvalidInput, NotFoundError
 
@@ -32,9 +33,12 @@ class SignInBody(BaseModel):
 
 class UserBody(BaseModel):
     model_config = ConfigDict(extra="forbid")
-    name: StrictStr
-    password: StrictStr
-    level: StrictInt = Field(description="1 manufacturer, 2 service, 3 user")
+    # the schema states the service's rules (app/access/service.py), which keep their messages
+    name: StrictStr = Field(json_schema_extra={"pattern": USER_NAME.pattern})
+    password: StrictStr = Field(json_schema_extra={"minLength": MIN_PASSWORD},
+                                description=f"at least {MIN_PASSWORD} characters")
+    level: StrictInt = Field(description="1 manufacturer, 2 service, 3 user",
+                             json_schema_extra={"minimum": 1, "maximum": 3})
 
 
 class TokenBody(BaseModel):

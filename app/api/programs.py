@@ -19,7 +19,8 @@ router = APIRouter(prefix="/programs", tags=["programs"])
 class ProgramBody(BaseModel):
     model_config = ConfigDict(extra="forbid", json_schema_extra={"examples": [
         {"name": "BORE1", "text": "N10 G54 G0 X0 Y0\nN20 _MVAR=101 _SETVAL=20 _KNUM=1\nN30 CYCLE977\nN40 M30"}]})
-    name: StrictStr = Field(description="letters, digits and _, starting with a letter (1..32)")
+    name: StrictStr = Field(description="letters, digits and _, starting with a letter (1..32)",
+                            json_schema_extra={"pattern": PROGRAM_NAME.pattern})
     text: StrictStr = Field(description="the program text, at most 1 MiB (413 above)")
 
 

@@ -85,3 +85,22 @@ def test_what_the_schema_refuses_the_api_refuses(client):
         assert answer.json()["error"]["field"] == field, url
     assert client.get("/api/tools/10000").status_code == 422
     assert 10000 not in [tool["t"] for tool in client.get("/api/tools").json()]
+
+
+def test_the_schema_states_the_rules_of_a_new_user_and_a_program_name(app, client):
+    """The body fields the services check by rule: a schema that says so (the password policy of
+    docs/hardening.md: at least 8 characters; levels 1..3), and the API refuses what it refuses."""
+    import re
+
+    schemas = app.openapi()["components"]["schemas"]
+    user = schemas["UserBody"]["properties"]
+    assert user["password"]["minLength"] == 8
+    assert (user["level"]["minimum"], user["level"]["maximum"]) == (1, 3)
+    name = re.compile(user["name"]["pattern"])
+    assert name.search("anna.k@plant-2") and not name.search("") and not name.search("-anna")
+    program = re.compile(schemas["ProgramBody"]["properties"]["name"]["pattern"])
+    assert program.search("BORE1") and not program.search("1BORE") and not program.search("")
+    assert client.post("/api/programs", json={"name": "1BORE", "text": "M30"}).status_code == 422
+    assert client.post("/api/users", json={"name": "-anna", "password": "long-enough-1", "level": 3}).status_code == 422
+    assert client.post("/api/users", json={"name": "anna", "password": "short", "level": 3}).status_code == 422
+    assert client.get("/api/users").json() == []
