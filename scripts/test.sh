@@ -36,7 +36,8 @@ fi
 # import contracts (.importlinter): the layers of design.md §2 and no cycles, function-level imports included
 .venv/bin/lint-imports --no-cache >/dev/null || .venv/bin/lint-imports --no-cache
 if [ "$#" -gt 0 ]; then exec .venv/bin/python -m pytest "$@"; fi
-.venv/bin/python -m pytest
+# two workers (pytest-xdist): the tests that start a LinuxCNC share one of them (tests/conftest.py)
+.venv/bin/python -m pytest -n 2 --dist loadgroup
 # the plant mode (docs/plant.md): the database, migration, concurrency and plant tests again on
 # PostgreSQL, in a private cluster the tests start and stop (tests/pgcluster.py)
 exec .venv/bin/python -m pytest --db-engine=postgresql tests/db tests/plant
