@@ -9,7 +9,7 @@ import shutil
 import pytest
 from fastapi.testclient import TestClient
 from hmi_testdata import TEST_SCENARIO, test_scenario
-from live import CHROMIUM_ARGS, browser_tab, serve
+from live import CHROMIUM_ARGS, MIN_WAIT_MS, browser_tab, serve
 from pgcluster import database_settings
 
 # --- the database engine: SQLite by default, PostgreSQL with --db-engine=postgresql ------------
@@ -114,8 +114,9 @@ def live_server(tmp_path_factory):
 
 @pytest.fixture(scope="session")
 def browser():
-    from playwright.sync_api import sync_playwright
+    from playwright.sync_api import expect, sync_playwright
 
+    expect.set_options(timeout=MIN_WAIT_MS)     # expect's own ceiling (5 s by default) as browser_tab's
     with sync_playwright() as playwright:
         chromium = playwright.chromium.launch(executable_path="/usr/bin/chromium", args=CHROMIUM_ARGS)
         yield chromium

@@ -11,6 +11,7 @@ from pathlib import Path
 
 from waiting import wait_until
 
+MIN_WAIT_MS = 15000     # the shortest ceiling of a Playwright wait (page loads, locators, expect)
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                  "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 
@@ -26,10 +27,12 @@ def wait_for_requests(page, held, count: int = 1, timeout_s: float = 5.0) -> Non
 
 
 @contextmanager
-def browser_tab(browser, base_url: str, width: int = 1280, height: int = 720, timeout_ms: int = 5000):
-    """A page in a fresh browser context on ``base_url``; the context is closed afterwards."""
+def browser_tab(browser, base_url: str, width: int = 1280, height: int = 720, timeout_ms: int = 15000):
+    """A page in a fresh browser context on ``base_url``; the context is closed afterwards. Waits end
+    as soon as their state shows; the ceiling is at least 15 s, as the suite runs on two workers beside
+    other load (a page load took over 5 s at load 14)."""
     context = browser.new_context(viewport={"width": width, "height": height}, base_url=base_url)
-    context.set_default_timeout(timeout_ms)
+    context.set_default_timeout(max(timeout_ms, MIN_WAIT_MS))
     try:
         yield context.new_page()
     finally:
