@@ -1,5 +1,5 @@
 """Screenshots of the main screens for docs/screens/ (issue [operator-ux] item 12): the demo
-scenario at 1280 x 800, English, and the JOG and a measuring screen in German and Chinese.
+scenario at 1280 x 800, each screen in English, German and Chinese (issue [screens] item 8).
 
     .venv/bin/python scripts/screenshots.py
 """
@@ -17,8 +17,9 @@ from live import CHROMIUM_ARGS, browser_tab, serve  # noqa: E402
 
 SCREENS = {"jog": "/jog", "measure-corner": "/measure/workpiece/corner/right", "offsets": "/offsets",
            "machine-view": "/machine-view", "probes": "/probes", "tools": "/tools", "log": "/log",
-           "settings": "/settings", "mda": "/mda"}
-LANGUAGES = {"de": ("jog", "measure-corner"), "zh": ("jog", "measure-corner", "offsets")}
+           "settings": "/settings", "mda": "/mda", "memories": "/memories", "plc": "/plc", "programs": "/programs",
+           "tool-probes": "/tool-probes", "kinematics": "/kinematics", "parts": "/parts", "spc": "/spc"}
+LANGUAGES = {"de": tuple(SCREENS), "zh": tuple(SCREENS)}
 
 
 def main() -> None:
