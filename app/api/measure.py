@@ -10,6 +10,7 @@ from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictInt
 
 from app.access.deps import needs, require_measurement
 from app.deps import WorkflowDep
+from app.errors import WorkflowError
 from app.workflow.tasks import MAX_FIT_POINTS, TASKS
 
 router = APIRouter(prefix="/measure", tags=["measure"])
@@ -58,6 +59,9 @@ def create_session(request: Request, body: CreateBody, workflow: WorkflowDep) ->
     """Open the input screen of a task: a new session (replaces an idle one). Measuring into a zero
     offset, a probe calibration or tool measuring also needs that write's level."""
     params = dict(body.params)
+    if body.target is not None and not isinstance(body.target, str | dict):      # false, 0, a list
+        raise WorkflowError(400, "invalid_target", "target: a zero offset's name or a tool offset object",
+                            "target")
     target = body.target or params.pop("target", None)
     require_measurement(request, body.task, target)
     return workflow.create(body.task, params, target).to_api()

@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import pytest
+
 
 def test_a_405_names_the_allowed_methods(client):
     answer = client.delete("/api/machine")
@@ -104,3 +106,12 @@ def test_the_schema_states_the_rules_of_a_new_user_and_a_program_name(app, clien
     assert client.post("/api/users", json={"name": "-anna", "password": "long-enough-1", "level": 3}).status_code == 422
     assert client.post("/api/users", json={"name": "anna", "password": "short", "level": 3}).status_code == 422
     assert client.get("/api/users").json() == []
+
+
+@pytest.mark.parametrize("target", [False, 0, ["G54"]])
+def test_a_measuring_target_of_the_wrong_type_is_refused(client, target):
+    """schemathesis ST201: ``"target": false`` used to open a session on the default target."""
+    answer = client.post("/api/measure", json={"task": "edge.set", "target": target,
+                                               "params": {"axis": "Z", "direction": "-", "setpoint": 0}})
+    assert answer.status_code == 400 and answer.json()["error"]["field"] == "target"
+    assert client.get("/api/measure/current").json() is None
