@@ -25,19 +25,20 @@ def pytest_configure(config):
     config.addinivalue_line("markers", "sqlite_only: reads the SQLite file itself (skipped on PostgreSQL)")
 
 
-@pytest.hookimpl(tryfirst=True)     # before pytest-xdist reads the groups
+@pytest.hookimpl(tryfirst=True)     # before `-m` deselects (the mark `linuxcnc` below)
 def pytest_collection_modifyitems(config, items):
     if config.getoption("--db-engine") == "postgresql":
         skip = pytest.mark.skip(reason="reads the SQLite file itself")
         for item in items:
             if "sqlite_only" in item.keywords:
                 item.add_marker(skip)
-    # one LinuxCNC at a time on a computer (/tmp/linuxcnc.lock, its shared memory): with pytest-xdist
-    # (scripts/test.sh, --dist loadgroup) every test that starts one runs on the same worker
+    # every test that starts a LinuxCNC carries the mark `linuxcnc`, set here before `-m` selects:
+    # scripts/test.sh runs them on their own, one at a time (one LinuxCNC per computer, and an
+    # xdist worker starting one was interrupted), and the rest on two workers
     for item in items:
         if (item.nodeid.startswith("tests/linuxcnc/") or "[linuxcnc" in item.nodeid
                 or item.get_closest_marker("linuxcnc") is not None):
-            item.add_marker(pytest.mark.xdist_group("linuxcnc"))
+            item.add_marker(pytest.mark.linuxcnc)
 
 
 @pytest.fixture(scope="session")
