@@ -36,10 +36,9 @@ fi
 # import contracts (.importlinter): the layers of design.md §2 and no cycles, function-level imports included
 .venv/bin/lint-imports --no-cache >/dev/null || .venv/bin/lint-imports --no-cache
 if [ "$#" -gt 0 ]; then exec .venv/bin/python -m pytest "$@"; fi
-# two workers (pytest-xdist) for all but the tests that start a LinuxCNC (mark `linuxcnc`,
-# tests/conftest.py); those run after, one at a time: one LinuxCNC per computer
-.venv/bin/python -m pytest -n 2 -m "not linuxcnc"
-.venv/bin/python -m pytest -m linuxcnc
+# one process: on two workers (pytest-xdist, `-n 2 -m "not linuxcnc"`) the suite took 14 of its
+# 25 minutes' share but the CPU is the limit on 2 cores, and three timing-bound e2e tests failed
+.venv/bin/python -m pytest
 # the plant mode (docs/plant.md): the database, migration, concurrency and plant tests again on
 # PostgreSQL, in a private cluster the tests start and stop (tests/pgcluster.py)
 exec .venv/bin/python -m pytest --db-engine=postgresql tests/db tests/plant

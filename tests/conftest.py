@@ -33,8 +33,8 @@ def pytest_collection_modifyitems(config, items):
             if "sqlite_only" in item.keywords:
                 item.add_marker(skip)
     # every test that starts a LinuxCNC carries the mark `linuxcnc`, set here before `-m` selects:
-    # scripts/test.sh runs them on their own, one at a time (one LinuxCNC per computer, and an
-    # xdist worker starting one was interrupted), and the rest on two workers
+    # with pytest-xdist run them on their own, one at a time (one LinuxCNC per computer, and an
+    # xdist worker that started one was interrupted): `pytest -n 2 -m "not linuxcnc"`, `pytest -m linuxcnc`
     for item in items:
         if (item.nodeid.startswith("tests/linuxcnc/") or "[linuxcnc" in item.nodeid
                 or item.get_closest_marker("linuxcnc") is not None):

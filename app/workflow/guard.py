@@ -20,7 +20,7 @@ import numpy as np
 
 from app.errors import ConflictError
 from app.i18n import N_
-from app.machine.protocol import ProbeReach, ProtectedSpace
+from app.machine.protocol import Machine, ProbeReach, ProtectedSpace
 from app.workflow.executor import StepExecutor
 from engine import alarms
 from engine.guard import (
@@ -69,9 +69,7 @@ def braking_for(machine, spec) -> Braking | None:
     override is the one in effect, at least 100 % (it may be turned up during the measurement)."""
     if not isinstance(machine, ProbeReach):
         return None
-    read = getattr(machine, "status", None)
-    status = read() if callable(read) else None
-    override = max(100.0, float(getattr(status, "feed_override", 100.0) or 100.0))
+    override = max(100.0, float(machine.status().feed_override or 100.0)) if isinstance(machine, Machine) else 100.0
     return braking_from_data(machine.probe_braking(), spec.probe_used, override)
 
 
