@@ -36,8 +36,8 @@ fi
 # import contracts (.importlinter): the layers of design.md §2 and no cycles, function-level imports included
 .venv/bin/lint-imports --no-cache >/dev/null || .venv/bin/lint-imports --no-cache
 if [ "$#" -gt 0 ]; then exec .venv/bin/python -m pytest "$@"; fi
-# one process: on two workers (pytest-xdist, `-n 2 -m "not linuxcnc"`) the suite took 14 of its
-# 25 minutes' share but the CPU is the limit on 2 cores, and three timing-bound e2e tests failed
+# one process: two workers (pytest-xdist, `-n 2 -m "not linuxcnc"`) gained little on 2 cores,
+# where CPU is the limit, and three timing-bound e2e tests failed there
 .venv/bin/python -m pytest
 # the plant mode (docs/plant.md): the database, migration, concurrency and plant tests again on
 # PostgreSQL, in a private cluster the tests start and stop (tests/pgcluster.py)
