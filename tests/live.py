@@ -71,3 +71,35 @@ def serve(root: Path, scenario: dict, start_timeout_s: float = 15.0, settings: d
     finally:
         server.should_exit = True
         thread.join(timeout=5)
+
+
+@contextmanager
+def hmi_process(db: str, scenario_file: Path, what: str) -> Iterator[str]:
+    """``python -m app --db <db>`` as its own process on a free port until it answers /api/health;
+    yields its base URL and ends it afterwards (``what``: the wait's description)."""
+    import subprocess
+    import sys
+
+    import httpx
+
+    port = free_port()
+    server = subprocess.Popen([sys.executable, "-m", "app", "--db", db, "--port", str(port),
+                               "--scenario", str(scenario_file)], stdout=subprocess.DEVNULL,
+                              stderr=subprocess.PIPE, text=True)
+    url = f"http://127.0.0.1:{port}"
+
+    def healthy() -> bool:
+        if server.poll() is not None:
+            raise AssertionError(f"the HMI ended: {server.stderr.read() if server.stderr else ''}")
+        try:
+            return httpx.get(f"{url}/api/health").status_code == 200
+        except httpx.TransportError:
+            return False
+
+    try:
+        wait_until(healthy, what, 60)
+        yield url
+    finally:
+        server.terminate()
+        server.wait(timeout=30)
+

@@ -5,14 +5,12 @@ starts read only, every screen and GET answers with the stored data, every write
 from __future__ import annotations
 
 import subprocess
-import sys
 
 import fastapi.routing
 import httpx
 import pytest
 from fastapi.testclient import TestClient
-from live import free_port
-from waiting import wait_until
+from live import hmi_process
 
 from app.config import Settings
 from app.main import create_app
@@ -120,25 +118,7 @@ def test_a_writable_database_shows_no_banner(client):
 
 def test_the_command_line_starts_on_a_read_only_database(read_only_db, scenario_file):
     target, folder = read_only_db
-    port = free_port()
-    server = subprocess.Popen([sys.executable, "-m", "app", "--db", target, "--port", str(port),
-                               "--scenario", str(scenario_file)], stdout=subprocess.DEVNULL,
-                              stderr=subprocess.PIPE, text=True)
-    try:
-        url = f"http://127.0.0.1:{port}"
-
-        def healthy():
-            if server.poll() is not None:
-                raise AssertionError(f"the HMI ended: {server.stderr.read()}")
-            try:
-                return httpx.get(f"{url}/api/health").status_code == 200
-            except httpx.TransportError:
-                return False
-
-        wait_until(healthy, "the HMI answers on a read-only database", 60)
+    with hmi_process(target, scenario_file, "the HMI answers on a read-only database") as url:
         assert httpx.get(f"{url}/api/offsets/G54").json()["trans"]["X"] == STORED_X
         refused = httpx.put(f"{url}/api/offsets/G54", json={"trans": {"X": 1.0}})
         assert refused.status_code == 503 and str(folder) not in refused.text
-    finally:
-        server.terminate()
-        server.wait(timeout=30)

@@ -5,15 +5,11 @@ be read, so the screens show the default data; every GET answers, every write an
 
 from __future__ import annotations
 
-import subprocess
-import sys
-
 import httpx
 import pytest
 from fastapi.testclient import TestClient
-from live import free_port
+from live import free_port, hmi_process
 from test_read_only_start import _screens
-from waiting import wait_until
 
 from app.config import Settings
 from app.main import create_app
@@ -76,25 +72,7 @@ def test_the_banner_says_why_in_the_operators_language(unreachable_client):
 
 
 def test_the_command_line_starts_read_only(unreachable_url, scenario_file):
-    port = free_port()
-    server = subprocess.Popen([sys.executable, "-m", "app", "--db", unreachable_url, "--port", str(port),
-                               "--scenario", str(scenario_file)], stdout=subprocess.DEVNULL,
-                              stderr=subprocess.PIPE, text=True)
-    try:
-        url = f"http://127.0.0.1:{port}"
-
-        def healthy():
-            if server.poll() is not None:
-                raise AssertionError(f"the HMI ended: {server.stderr.read()}")
-            try:
-                return httpx.get(f"{url}/api/health").status_code == 200
-            except httpx.TransportError:
-                return False
-
-        wait_until(healthy, "the HMI answers on an unreachable database", 60)
+    with hmi_process(unreachable_url, scenario_file, "the HMI answers on an unreachable database") as url:
         assert httpx.get(f"{url}/api/offsets/G54").status_code == 200
         refused = httpx.put(f"{url}/api/offsets/G54", json={"trans": {"X": 1.0}})
         assert refused.status_code == 503 and refused.json()["error"]["code"] == "storage_unavailable"
-    finally:
-        server.terminate()
-        server.wait(timeout=30)
