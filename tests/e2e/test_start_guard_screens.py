@@ -23,6 +23,19 @@ def into_the_hole(api) -> dict:
     return api.get("/api/machine").json()["mcs"]
 
 
+def hole1_screen_with_diameter(page, diameter: float):
+    """The hole.1 screen, measuring only, with ``diameter`` typed in; returns the diameter field."""
+    page.goto("/measure/workpiece/pocket/hole1")
+    expect(page.locator("#task-form")).to_be_visible()
+    target = page.locator('#task-form select[name="target"]')
+    if target.count():
+        target.select_option("measure_only")
+    field = page.locator('#task-form [name="diameter"]')
+    field.fill(f"{diameter:g}")
+    field.press("Tab")
+    return field
+
+
 def test_the_3d_view_marks_the_refused_segment(page, api):
     into_the_hole(api)
     assert api.post("/api/measure", json={"task": "hole.1", "params": {"diameter": 130}}).status_code == 200
@@ -37,14 +50,7 @@ def test_the_3d_view_marks_the_refused_segment(page, api):
 
 def test_nc_start_on_the_screen_says_why_nothing_moved(page, api):
     before = into_the_hole(api)
-    page.goto("/measure/workpiece/pocket/hole1")
-    expect(page.locator("#task-form")).to_be_visible()
-    target = page.locator('#task-form select[name="target"]')
-    if target.count():
-        target.select_option("measure_only")
-    field = page.locator('#task-form [name="diameter"]')
-    field.fill("130")
-    field.press("Tab")
+    hole1_screen_with_diameter(page, 130)
     expect(page.locator(".htmx-request")).to_have_count(0)       # the form's own request has answered
     page.locator("#nc-start").click()
     expect(page.locator("body")).to_contain_text("65300", timeout=5000)
@@ -54,14 +60,7 @@ def test_nc_start_on_the_screen_says_why_nothing_moved(page, api):
 
 def test_the_measuring_screens_picture_marks_the_refused_segment(page, api):
     before = into_the_hole(api)
-    page.goto("/measure/workpiece/pocket/hole1")
-    expect(page.locator("#task-form")).to_be_visible()
-    target = page.locator('#task-form select[name="target"]')
-    if target.count():
-        target.select_option("measure_only")
-    field = page.locator('#task-form [name="diameter"]')
-    field.fill("130")
-    field.press("Tab")
+    field = hole1_screen_with_diameter(page, 130)
     top = page.locator("#task-svg-top")
     expect(top).to_have_attribute("data-guard-refused", re.compile(r"^P1"), timeout=5000)
     expect(top.locator(".guard-refused")).to_have_count(1)
