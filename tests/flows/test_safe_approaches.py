@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import pytest
 import test_start_guard as guarded
-from truthkit import Operator
 
 BOSS_C, BOSS_H, BOSS_SIZE = guarded.BOSS_C, guarded.BOSS_H, guarded.BOSS_SIZE
 HOLE_C, HOLE_D = guarded.HOLE_C, guarded.HOLE_D
@@ -42,12 +41,7 @@ NAMES = ("above", "off-centre", "far-off")
 
 @pytest.fixture
 def op(client):
-    operator = Operator(client, guarded.guard_scenario())
-    operator.load()
-    pose = operator.scen["workpiece"]["pose"]
-    operator.put_offset("G54", rot=pose["rot"], trans=pose["trans"])
-    operator.activate("G54")
-    return operator
+    return guarded.operator_in_g54(client)
 
 
 @pytest.mark.parametrize(("task", "start"), RUNS, ids=[f"{t}-{NAMES[i]}" for t, i in RUNS])

@@ -35,14 +35,19 @@ def guard_scenario() -> dict:
     return data
 
 
-@pytest.fixture
-def op(client):
+def operator_in_g54(client) -> Operator:
+    """An operator on the guard scenario with G54 on the part's corner, active."""
     operator = Operator(client, guard_scenario())
     operator.load()
     pose = operator.scen["workpiece"]["pose"]
     operator.put_offset("G54", rot=pose["rot"], trans=pose["trans"])       # G54 on the part's corner
     operator.activate("G54")
     return operator
+
+
+@pytest.fixture
+def op(client):
+    return operator_in_g54(client)
 
 
 def machine(op: Operator) -> dict:

@@ -29,12 +29,7 @@ def braking_by_hand(feed_mm_min: float, t: float = 0.0, a: float = 1.0, kv: floa
 
 @pytest.fixture
 def op(client):
-    operator = Operator(client, guarded.guard_scenario())
-    operator.load()
-    pose = operator.scen["workpiece"]["pose"]
-    operator.put_offset("G54", rot=pose["rot"], trans=pose["trans"])
-    operator.activate("G54")
-    return operator
+    return guarded.operator_in_g54(client)
 
 
 def stored(op: Operator) -> dict:
