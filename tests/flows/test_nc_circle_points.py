@@ -9,20 +9,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from truthkit import HOLE_D, HOLES, SPIGOT_D, SPIGOT_H, SPIGOTS, TOL_MM, Operator, scenario
+import test_nc_cycles_truth as cycles_truth
+from truthkit import HOLE_D, HOLES, SPIGOT_D, SPIGOT_H, SPIGOTS, TOL_MM, scenario
 
 DEPTH = -8.0
 
 
-class Nc(Operator):
-    def mda(self, text: str, state: str = "done") -> dict:
-        answer = self.ok(self.c.post("/api/nc/run", json={"mda": text}))
-        assert answer["state"] == state, answer
-        return answer
-
-    def ovr(self) -> list[float]:
-        return self.ok(self.c.get("/api/nc/variables", params={"names": "_OVR"}))["_OVR"]
-
+class Nc(cycles_truth.Nc):
     def wcs_of(self, part_point) -> np.ndarray:
         return self.frame("G54").to_child(self.part.mcs(*part_point))
 
