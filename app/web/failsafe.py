@@ -7,6 +7,8 @@ place instead of an empty picture."""
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
+from typing import TypeVar
 
 from markupsafe import Markup, escape
 
@@ -27,3 +29,27 @@ def picture_failed(what: str) -> Markup:
     log.exception("drawing %s failed", what)
     return Markup('<p class="alarm picture-error">{}</p>').format(
         escape(_("The picture could not be drawn: internal error (see the HMI log).")))
+
+
+T = TypeVar("T")
+F = TypeVar("F")
+
+
+class PictureFailed(Exception):
+    """A part of a picture met a bug, logged with its traceback: ``line`` is the error line the
+    screen shows in the picture's place."""
+
+    def __init__(self, line: Markup):
+        super().__init__(str(line))
+        self.line = line
+
+
+def drawn(what: str, compute: Callable[[], T], fallback: F) -> T | F:
+    """``compute()``, or ``fallback`` on a domain error (the screen already says why). Anything
+    else is a bug: logged with its traceback, then raised as PictureFailed."""
+    try:
+        return compute()
+    except EXPECTED:
+        return fallback
+    except Exception as exc:        # a bug: logged, and shown in the picture's place
+        raise PictureFailed(picture_failed(what)) from exc

@@ -17,7 +17,7 @@ from app.workflow.executor import StepExecutor
 from engine.turning_plan import lathe_planned_path, prepare
 from engine.types import MoveStep, ProbeStep
 
-from .failsafe import EXPECTED, picture_failed
+from .failsafe import EXPECTED, PictureFailed, drawn
 from .lathe_view import lathe_svg
 from .templating import fmt_result
 
@@ -138,30 +138,30 @@ def _path_points(prep, start, tip) -> list[list[float]]:
     return points
 
 
+def _next_path(env, spec, params: dict) -> list[list[float]]:
+    """The planned path of the next NC Start from where the tool tip is (MCS points)."""
+    ctx = env.measuring_context()
+    normalised = spec.validate(params, ctx.plane)
+    plan_ctx = spec.plan_context(ctx, normalised)
+    prep = prepare(spec.name, normalised, plan_ctx)
+    tip = spec.tool_tip(ctx)
+    start = StepExecutor(env.machine.machine, ctx.chain().wcs2bcs, ctx.tool_length, ctx.plane.infeed_unit,
+                         tip=tip).current(prep.coords)
+    return _path_points(prep, start, tip)
+
+
 def lathe_svgs(env, spec, params: dict | None, answer: dict | None) -> list:
     """The real set-up with the planned path of the next NC Start (never breaks the screen)."""
     try:
-        scene = env.machine.scene_geometry()
-        limits = env.machine.limits()
-    except EXPECTED:
-        return []
-    except Exception:
-        return [picture_failed("the lathe set-up")]
-    path = None
-    if params is not None and not (answer or {}).get("result"):
-        try:
-            ctx = env.measuring_context()
-            normalised = spec.validate(params, ctx.plane)
-            plan_ctx = spec.plan_context(ctx, normalised)
-            prep = prepare(spec.name, normalised, plan_ctx)
-            tip = spec.tool_tip(ctx)
-            start = StepExecutor(env.machine.machine, ctx.chain().wcs2bcs, ctx.tool_length, ctx.plane.infeed_unit,
-                                 tip=tip).current(prep.coords)
-            path = _path_points(prep, start, tip)
-        except EXPECTED:
-            path = None
-        except Exception:
-            return [picture_failed("the lathe's planned path")]
+        setup = drawn("the lathe set-up", lambda: (env.machine.scene_geometry(), env.machine.limits()), None)
+        if setup is None:
+            return []
+        path = None
+        if params is not None and not (answer or {}).get("result"):
+            path = drawn("the lathe's planned path", lambda: _next_path(env, spec, params), None)
+    except PictureFailed as failed:     # a bug, logged: its error line stands in the picture's place
+        return [failed.line]
+    scene, limits = setup
     focus = {"lathe.toolprobe.calibrate": ("tool_probe",), "lathe.tool.measure": ("tool_probe",),
              "lathe.tool.auto": ("tool_probe",), "lathe.probe.groove": ("groove",)}.get(spec.name, ("part",))
     return [Markup(lathe_svg(scene, limits, path=path, svg_id="task-lathe", focus=focus,

@@ -28,7 +28,7 @@ from engine.plan import ideal_path
 from engine.planes import Plane
 from engine.types import MoveStep, ProbeStep
 
-from .failsafe import EXPECTED, log
+from .failsafe import EXPECTED, PictureFailed, drawn
 
 LOG_ENTRIES = 3          # the last measurements drawn as touches and results
 AXES = ("X", "Y", "Z")
@@ -86,17 +86,21 @@ def _plan(services, session) -> dict | None:
     spec = TASKS.get(session.task)
     if n is None or spec is None:
         return None
-    try:
+
+    def plan():
         ctx = MeasuringEnv(services.db, services.machine, services.settings).measuring_context()
         wcs2bcs = ctx.chain().wcs2bcs
         executor = StepExecutor(services.machine.machine, wcs2bcs, ctx.tool_length, ctx.plane.infeed_unit)
         start = np.asarray(executor.current(spec.coords))
-        steps = ideal_path(spec.program(session.params, n, start, planning.context_from(ctx)), start)
-    except EXPECTED:           # the measuring screen shows why NC Start refuses
+        return ctx, wcs2bcs, start, ideal_path(spec.program(session.params, n, start, planning.context_from(ctx)), start)
+
+    try:        # on a domain error the measuring screen shows why NC Start refuses
+        planned = drawn("the 3D view's planned path", plan, None)
+    except PictureFailed:      # a bug, logged: the view goes on without the path
         return None
-    except Exception:          # a bug: logged; the view goes on without the path
-        log.exception("the 3D view's planned path")
+    if planned is None:
         return None
+    ctx, wcs2bcs, start, steps = planned
     to_mcs = wcs2bcs.child2parent if spec.coords == "WCS" else (lambda p: np.asarray(p, dtype=float))
     if guard.guarded(spec) and spec.coords == "WCS":
         try:       # the start guard's path and verdicts (issue 24 §1): the refused segment is marked

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from typing import Literal, TypedDict
 
 import numpy as np
 from fastapi import APIRouter, HTTPException, Request
@@ -27,9 +28,10 @@ from engine.plan import ideal_path
 from engine.tasks import Family
 
 from . import measure, task_help, units
-from .failsafe import EXPECTED, picture_failed
+from .failsafe import EXPECTED, PictureFailed, drawn
 from .lathe_screens import lathe_correction_rows, lathe_result_rows, lathe_svgs, lathe_tool_info
 from .task_forms import (
+    FormData,
     field_of_error,
     form_data,
     friendly,
@@ -279,22 +281,32 @@ def correction_rows(correction: dict | None, gud=None) -> list[dict]:
     the tool data of a tool offset (length, radius and their wear, mm)."""
     if not correction or not correction.get("after"):
         return []
-    before, after = correction.get("before") or {}, correction["after"]
-    rows = []
     if correction.get("lathe"):
         return lathe_correction_rows(correction)
+    before, after = correction.get("before") or {}, correction["after"]
     if "tool" in correction:
-        for part in (None, "wear"):
-            new_part = after.get(part) if part else after
-            old_part = (before.get(part) if part else before) or {}
-            for key in ("length", "radius"):
-                if key not in (new_part or {}):
-                    continue
-                old, new = float(old_part.get(key, 0.0)), float(new_part[key])
-                rows.append({"label": field_name(f"{part}.{key}" if part else key).capitalize(),
-                             "field": f"{part}.{key}" if part else key, "before": fmt_result("length", old, gud),
-                             "after": fmt_result("length", new, gud), "changed": abs(new - old) > 1e-9})
-        return rows
+        return [row for part in (None, "wear") for row in _tool_part_rows(part, before, after, gud)]
+    return _frame_correction_rows(before, after, gud)
+
+
+def _tool_part_rows(part: str | None, before: dict, after: dict, gud) -> list[dict]:
+    """Length and radius of the tool (``part`` None) or of its wear, as they were and are."""
+    new_part = (after.get(part) if part else after) or {}
+    old_part = (before.get(part) if part else before) or {}
+    rows = []
+    for key in ("length", "radius"):
+        if key not in new_part:
+            continue
+        old, new = float(old_part.get(key, 0.0)), float(new_part[key])
+        rows.append({"label": field_name(f"{part}.{key}" if part else key).capitalize(),
+                     "field": f"{part}.{key}" if part else key, "before": fmt_result("length", old, gud),
+                     "after": fmt_result("length", new, gud), "changed": abs(new - old) > 1e-9})
+    return rows
+
+
+def _frame_correction_rows(before: dict, after: dict, gud) -> list[dict]:
+    """Offset, fine offset and rotation per axis of the frame, as they were and are."""
+    rows = []
     for part, label in (("trans", N_("Offset")), ("fine", N_("Fine")), ("rot", N_("Rotation"))):
         for axis, new in (after.get(part) or {}).items():
             old = (before.get(part) or {}).get(axis, 0.0)
@@ -313,104 +325,230 @@ def _svgs(env: _Env, task: str, params: dict | None, session, answer: dict | Non
     if spec.lathe:
         return lathe_svgs(env, spec, params, answer)
     try:
+        return _mill_svgs(env, task, params, session, answer)
+    except PictureFailed as failed:     # a bug, logged: its error line stands in the picture's place
+        return [failed.line]
+
+
+def _mill_svgs(env: _Env, task: str, params: dict | None, session, answer: dict | None) -> list:
+    spec = task_spec(task)
+
+    def at_start():
         ctx = env.measuring_context()
-        start = StepExecutor(env.machine.machine, ctx.chain().wcs2bcs, ctx.tool_length,
-                             ctx.plane.infeed_unit).current(spec.coords)
-    except EXPECTED:        # no probe position or no data: the screen says why
+        return ctx, StepExecutor(env.machine.machine, ctx.chain().wcs2bcs, ctx.tool_length,
+                                 ctx.plane.infeed_unit).current(spec.coords)
+
+    here = drawn("the measuring preview", at_start, None)
+    if here is None:        # no probe position or no data: the screen says why
         return []
-    except Exception:       # a bug: logged, and shown in the picture's place
-        return [picture_failed("the measuring preview")]
-    steps = []
+    ctx, start = here
+    steps: list = []
     refused = None
     result = (answer or {}).get("result")
     if params is not None and not result:
         n = (session.next_point() if session is not None else None) or 1
-        try:
-            normalised = spec.validate(params, ctx.plane)
-            steps = ideal_path(spec.program(normalised, n, np.asarray(start), planning.context_from(ctx)), start)
-        except EXPECTED:    # parameters the form marks as wrong: no path yet
-            steps = []
-        except Exception:
-            return [picture_failed("the planned path")]
-        if steps and guard.guarded(spec) and spec.coords == "WCS" and (session is None or session.guard):
-            try:            # the start guard's verdict: the segment NC Start would refuse is marked
-                refused = guard.check_point(env.machine.machine, spec, normalised, n, ctx)[0].refusal
-            except EXPECTED:
-                refused = None
-            except Exception:
-                return [picture_failed("the start guard's check")]
+        steps, refused = _next_path(env, spec, params, session, ctx, start, n)
     points = session.to_api()["points"] if session is not None else []
     radius = ctx.probe.ball_diameter / 2.0 if ctx.probe else float((ctx.tool or {}).get("radius") or 1.0)
     return draw(task, ctx.plane, params=params, start=start, steps=steps, points=points, result=result,
                 ball_radius=radius, refused=refused)
 
 
+def _next_path(env: _Env, spec, params: dict, session, ctx, start, n: int) -> tuple[list, object]:
+    """The planned path of point ``n`` (ideal latches; none for parameters the form marks as
+    wrong) and the step the start guard would refuse."""
+
+    def plan():
+        normalised = spec.validate(params, ctx.plane)
+        return normalised, ideal_path(spec.program(normalised, n, np.asarray(start), planning.context_from(ctx)),
+                                      start)
+
+    planned = drawn("the planned path", plan, None)
+    if planned is None:
+        return [], None
+    normalised, steps = planned
+    refused = None
+    if steps and guard.guarded(spec) and spec.coords == "WCS" and (session is None or session.guard):
+        # the start guard's verdict: the segment NC Start would refuse is marked
+        refused = drawn("the start guard's check",
+                        lambda: guard.check_point(env.machine.machine, spec, normalised, n, ctx)[0].refusal, None)
+    return steps, refused
+
+
+class FieldRow(TypedDict):
+    """One input field as the template draws it."""
+    spec: FieldSpec
+    value: str
+    error: str | None
+    locked: bool
+    id: str
+
+
+class ToolInfo(TypedDict, total=False):
+    """The tool in the spindle on a tool-measuring screen (``radius`` only with a tool in it)."""
+    t: int | None
+    length: float | None
+    mode: str
+    probe_number: int
+    radius: float | None
+
+
+class TaskScreenContext(TypedDict):
+    """What every measuring task's screen gives ``measure_task.html`` (the keys all three share)."""
+    lathe: bool
+    diamon: bool
+    page: TaskPage
+    task: str
+    fields: list[FieldRow]
+    form_error: str | None
+    points: list[dict]
+    n_points: int
+    single: bool
+    positions_tool: bool
+    can_calculate: bool
+    next_point: int | None
+    answer: dict | None
+    setup: dict | None
+    session_id: str | None
+    result_rows: list[tuple[str, str, str]]
+    correction: dict | None
+    correction_rows: list[dict]
+    warnings: list
+    alarm: str | None
+    alarm_remedy: str
+    notice: str
+    svgs: list
+    vkeys_task: bool
+    tool_mode: bool
+    decision: str | None
+    decision_alarm: object
+    running: bool
+    progress: dict
+    start_denied: str
+    help_picture: str | None
+    equipment: list
+
+
+class WorkpieceScreenContext(TaskScreenContext):
+    """A workpiece task's screen (``measure_workpiece``): no tool box."""
+    screen: Literal["measure_workpiece"]
+    tool: None
+
+
+class ToolScreenContext(TaskScreenContext):
+    """A tool-measuring task's screen (``measure_tool``): the tool in the spindle."""
+    screen: Literal["measure_tool"]
+    tool: ToolInfo
+
+
+class LatheScreenContext(TaskScreenContext):
+    """A lathe task's screen (``measure_lathe``): the tool in the turret."""
+    screen: Literal["measure_lathe"]
+    tool: dict | None
+
+
+ScreenContext = WorkpieceScreenContext | ToolScreenContext | LatheScreenContext
+
+
 def _screen_context(env: _Env, page: TaskPage, form: dict | None, *, answer=None, alarm=None, errors=None,
-                    notice: str = "") -> dict:
-    task = page.task
-    fields, session, data = _typed(env, task, form)
+                    notice: str = "") -> ScreenContext:
+    """The context of the task's input screen: the keys all screens share, then the screen's own."""
+    spec = task_spec(page.task)
+    common = _common_context(env, page, form, answer=answer, alarm=alarm, errors=errors or {}, notice=notice)
+    if spec.lathe:
+        return LatheScreenContext(screen="measure_lathe", tool=lathe_tool_info(env), **common)
+    if spec.family.tool_measuring:
+        return ToolScreenContext(screen="measure_tool", tool=_spindle_tool(env), **common)
+    return WorkpieceScreenContext(screen="measure_workpiece", tool=None, **common)
+
+
+def _spindle_tool(env: _Env) -> ToolInfo:
+    """The tool in the spindle, its radius with wear from the tool table (None when it has no row)."""
+    st = env.machine.status()
+    tool = ToolInfo(t=st["tool"], length=st["tool_length"], mode=env.gud.tool_offset_mode,
+                    probe_number=env.gud.tool_probe_number)
+    if st["tool"] is not None:
+        try:
+            row = env.services.tools.get(st["tool"])
+            tool["radius"] = float(row.get("radius") or 0.0) + float((row.get("wear") or {}).get("radius") or 0.0)
+        except EXPECTED:
+            tool["radius"] = None
+    return tool
+
+
+def _shown_answer(session, answer: dict | None) -> dict | None:
+    """The answer the screen shows: the one given, else the session's visible one; only with a result."""
+    if answer is None:
+        answer = _visible_answer(session)
+    return answer if answer is not None and "result" in answer else None
+
+
+def _setup_of(answer: dict | None) -> dict | None:
+    """The set-up support's hand-over, until it was carried out or left (then the result stays)."""
+    setup = (answer or {}).get("setup_support")
+    return None if setup and setup.get("done") else setup
+
+
+def _field_rows(fields: list[FieldSpec], data: FormData, errors: dict, locked: bool) -> list[FieldRow]:
+    return [FieldRow(spec=f, value=data.values.get(f.name, ""), error=errors.get(f.name), locked=f.locks and locked,
+                     id=f.name.replace(".", "-")) for f in fields]
+
+
+class _SessionPart(TypedDict):
+    running: bool
+    progress: dict
+    points: list[dict]
+    can_calculate: bool
+    next_point: int | None
+    session_id: str | None
+    alarm_remedy: str
+    notice: str
+
+
+def _session_part(session, n_points: int, alarm, notice: str) -> _SessionPart:
+    """The keys read from the task's session (or their values without one)."""
+    if session is None:
+        return _SessionPart(running=False, progress={}, points=[{"n": n, "stored": False} for n in range(1, n_points + 1)],
+                            can_calculate=False, next_point=1, session_id=None, alarm_remedy="", notice=notice or "")
     # running before the outcome: NC Start's thread sets the outcome, then ends running. Read the
     # other way round, a measurement ending meanwhile showed neither its progress nor its outcome,
     # and no later session event would ask again
-    running = bool(session is not None and session.running)
-    progress = (session.progress if session is not None else None) or {}
-    stored_any = _stored_any(session)
-    spec = task_spec(task)
-    n_points = spec.points
-    if answer is None:
-        answer = _visible_answer(session)
-    if answer is not None and "result" not in answer:
-        answer = None
-    setup = (answer or {}).get("setup_support")
-    if setup and setup.get("done"):         # carried out or left: the result stays, the hand-over goes
-        setup = None
-    points = session.to_api()["points"] if session is not None else \
-        [{"n": n, "stored": False} for n in range(1, n_points + 1)]
-    errors = errors or {}
-    tool = None
-    if spec.family.tool_measuring:
-        st = env.machine.status()
-        tool = {"t": st["tool"], "length": st["tool_length"], "mode": env.gud.tool_offset_mode,
-                "probe_number": env.gud.tool_probe_number}
-        if st["tool"] is not None:
-            try:
-                row = env.services.tools.get(st["tool"])
-                tool["radius"] = float(row.get("radius") or 0.0) + float((row.get("wear") or {}).get("radius") or 0.0)
-            except EXPECTED:
-                tool["radius"] = None
-    warnings = list((answer or {}).get("warnings") or (session.warnings if session is not None else []))
-    if spec.lathe:
-        tool = lathe_tool_info(env)
-    return {
-        "screen": "measure_lathe" if spec.lathe else ("measure_tool" if spec.family.tool_measuring
-                                                      else "measure_workpiece"),
-        "lathe": spec.lathe, "diamon": env.machine.diameter_programming,
-        "page": page, "task": task,
-        "fields": [{"spec": f, "value": data.values.get(f.name, ""), "error": errors.get(f.name),
-                    "locked": f.locks and stored_any, "id": f.name.replace(".", "-")} for f in fields],
-        "form_error": errors.get("_form"),
-        "points": points, "n_points": n_points, "single": n_points == 1,
+    running = bool(session.running)
+    return _SessionPart(running=running, progress=session.progress or {}, points=session.to_api()["points"],
+                        can_calculate=session.can_calculate, next_point=session.next_point() or None,
+                        session_id=session.id,
+                        alarm_remedy=((session.last_alarm or {}).get("remedy") if alarm else "") or "",
+                        notice=notice or session.notice or "")
+
+
+def _common_context(env: _Env, page: TaskPage, form: dict | None, *, answer, alarm, errors: dict,
+                    notice: str) -> TaskScreenContext:
+    task, spec = page.task, task_spec(page.task)
+    fields, session, data = _typed(env, task, form)
+    live = _session_part(session, spec.points, alarm, notice)
+    answer = _shown_answer(session, answer)
+    result = (answer or {}).get("result")
+    correction = (answer or {}).get("correction")
+    help_context = task_help.context(env.services, task, data.values)     # help picture, equipment (issue 17 item 5)
+    return TaskScreenContext(
+        lathe=spec.lathe, diamon=env.machine.diameter_programming, page=page, task=task,
+        fields=_field_rows(fields, data, errors, _stored_any(session)), form_error=errors.get("_form"),
+        n_points=spec.points, single=spec.points == 1,
         # on the tool probe the operator positions the tool, not the workpiece probe
-        "positions_tool": spec.category in (Category.TOOL_PROBE_CALIBRATION, Category.TOOL_MEASURING),
-        "can_calculate": session is not None and session.can_calculate,
-        "next_point": (session.next_point() if session is not None else 1) or None,
-        "answer": answer, "setup": setup, "session_id": session.id if session is not None else None,
-        "result_rows": result_rows(task, (answer or {}).get("result"), env.gud),
-        "correction": (answer or {}).get("correction"),
-        "correction_rows": correction_rows((answer or {}).get("correction"), env.gud),
-        "warnings": warnings, "alarm": alarm, "tool": tool,
-        "alarm_remedy": ((session.last_alarm or {}).get("remedy") if alarm and session is not None else "") or "",
-        "notice": notice or (session.notice if session is not None else "") or "",
-        "svgs": _svgs(env, task, data.params, session, answer),
-        "vkeys_task": True,
-        "tool_mode": data.values.get("target") == TOOL_TARGET,
-        "decision": _decision(answer),
-        "decision_alarm": ((answer or {}).get("result") or {}).get("alarm"),
-        "running": running,
-        "progress": progress,
-        "start_denied": _start_denied(env, spec, data),
-        **task_help.context(env.services, task, data.values),      # help picture, equipment (issue 17 item 5)
-    }
+        positions_tool=spec.category in (Category.TOOL_PROBE_CALIBRATION, Category.TOOL_MEASURING),
+        answer=answer, setup=_setup_of(answer),
+        result_rows=result_rows(task, result, env.gud),
+        correction=correction, correction_rows=correction_rows(correction, env.gud),
+        warnings=list((answer or {}).get("warnings") or (session.warnings if session is not None else [])),
+        alarm=alarm,
+        svgs=_svgs(env, task, data.params, session, answer),
+        vkeys_task=True,
+        tool_mode=data.values.get("target") == TOOL_TARGET,
+        decision=_decision(answer), decision_alarm=(result or {}).get("alarm"),
+        start_denied=_start_denied(env, spec, data),
+        help_picture=help_context["help_picture"], equipment=help_context["equipment"],
+        **live,
+    )
 
 
 def _start_denied(env: _Env, spec, data) -> str:
@@ -432,10 +570,10 @@ def _decision(answer: dict | None) -> str | None:
     return _(DECISIONS[decision]) if decision in DECISIONS else None
 
 
-def _render(request: Request, ctx: dict, message: str = "", level: str = "info", status_code: int = 200):
+def _render(request: Request, ctx: ScreenContext, message: str = "", level: str = "info", status_code: int = 200):
     """Full page on a normal GET; on htmx the screen + softkeys + message line."""
     if not is_htmx(request):
-        return render_screen(request, TEMPLATE, ctx, status_code=status_code)
+        return render_screen(request, TEMPLATE, dict(ctx), status_code=status_code)
     return render_blocks(request, TEMPLATE, ["screen", "vsoftkeys", "hsoftkeys", "message"],
                          {**ctx, "message": message, "level": level}, status_code)
 
