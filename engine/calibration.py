@@ -48,7 +48,7 @@ from engine import alarms, checks
 from engine.compensation import centre_trigger_value
 from engine.frames import Frame, rot_z
 from engine.lobing import LobingMap, fit_lobing_map
-from engine.plan_base import RingCalibrationPoint, RingPass
+from engine.plan_base import BoreCalibrationPoint, RingCalibrationPoint, RingPass
 from engine.planes import PLANES, Plane, axis_index
 from engine.types import EdgePoint, FloatArray, MeasuringError, ProbeRecord
 
@@ -203,6 +203,104 @@ def calibrate_radius(point: RingCalibrationPoint, probe: ProbeRecord, plane: Pla
         "effective_diameter_difference": (None if probe.effective_diameter <= 0.0
                                           else d_eff - probe.effective_diameter),
     }
+    return record, values
+
+
+def _bore_key(u: FloatArray, nominal: str, plane: Plane) -> str:
+    """The stored field of travel direction ``u``: the axis direction closest to it (a tie, at
+    45°, keeps the ``nominal`` one: "+1" -> the 1st axis' +), measuring-math §7.4."""
+    axes = {f"{a}{s}": (1.0 if s == "+" else -1.0) * plane.unit(a)
+            for a in (plane.first, plane.second) for s in ("+", "-")}
+    first = {"1": plane.first, "2": plane.second}[nominal[1]]
+    best = f"{first}{nominal[0]}"
+    top = float(axes[best] @ u)
+    for key, v in axes.items():
+        if float(v @ u) > top + 1e-9:
+            best, top = key, float(v @ u)
+    return best
+
+
+def _bore_skew(point: BoreCalibrationPoint, plane: Plane, old: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """(bore centre MP, measured skew e in the WCS plane; components not observed stay ``old``):
+    unknown centre MP = (m0 + m180)/2, e = (m180 − m0)/2 (measuring-math §7.3); known centre, per
+    pair of opposite directions u: e·u = (MP − (rec(+u) + rec(−u))/2)·u (measuring-math §7.2)."""
+    p = plane.infeed_unit
+    if point.pass_centres is not None:
+        m180, m0 = point.pass_centres
+        e = 0.5 * (m180 - m0)
+        return 0.5 * (m0 + m180), e - float(e @ p) * p
+    assert point.centre is not None
+    centre, e = np.asarray(point.centre, float), old.copy()
+    rec = dict(zip(point.keys, point.rec, strict=True))
+    for axis in ("1", "2"):
+        if f"+{axis}" in rec and f"-{axis}" in rec:
+            u = point.units[point.keys.index(f"+{axis}")]
+            e = e + (float((centre - 0.5 * (rec[f"+{axis}"] + rec[f"-{axis}"])) @ u) - float(e @ u)) * u
+    return centre, e
+
+
+def _checked_trigger(key: str, value: float, probe: ProbeRecord, safe_area: float | None, setval: float) -> float:
+    """``value`` of field ``key``, or 61303 for a wrong sign or a change above _TSA."""
+    if value == 0.0 or (value < 0.0) != key.endswith("+"):
+        raise MeasuringError(alarms.SAFE_AREA, f"trigger value {key} = {value:.4f} has the wrong sign: "
+                                               f"check _SETVAL = {setval:g}")
+    old = float(probe.trigger.get(key) or 0.0)
+    if safe_area is not None and abs(value - old) > safe_area:
+        raise MeasuringError(alarms.SAFE_AREA, f"trigger value {key} = {value:.4f} differs by {abs(value - old):.4f} "
+                                               f"mm from the stored {old:.4f}: more than _TSA = {safe_area:g}")
+    return value
+
+
+def calibrate_bore(point: BoreCalibrationPoint, probe: ProbeRecord, plane: Plane, *, skew_wcs: npt.ArrayLike,
+                   with_skew: bool, with_ball: bool, safe_area: float | None = None,
+                   wcs2bcs: Frame | None = None, spindle_angle: float = 0.0) -> tuple[ProbeRecord, dict[str, Any]]:
+    """CYCLE976 in a bore along 1, 2 or 4 directions, axis-parallel or at the angle _STA1
+    (manual §5.3.1/§5.3.2, measuring-math §7.2–7.4).
+
+    The ball centre of a touch is c = rec + e (e: the measured skew when ``with_skew``, else the
+    stored ``skew_wcs``); with v = c − MP, A = v·u, h = v·w (w ⟂ u in the plane) the trigger
+    value along u is τ = A + h²/(2A) − D/2 (the chord's sagitta to second order, 0 on a diameter),
+    stored in the field of the axis direction closest to u: τ for a + field, −τ for a − field
+    (measuring-math §7.4). ``with_ball``: d_eff = mean over opposite pairs of t(−) − t(+).
+    ``safe_area`` (_TSA): a change above it refuses with 61303, as a wrong sign does. The skew
+    is stored in machine X/Y at spindle 0° (turned back from ``spindle_angle``, the SPOS of the
+    touches).
+    """
+    old = np.asarray(skew_wcs, dtype=float)
+    centre, measured = _bore_skew(point, plane, old)
+    e = measured if with_skew else old
+    p = plane.infeed_unit
+    half = point.diameter / 2.0
+    triggers: dict[str, float] = {}
+    taus: dict[str, float] = {}
+    for key, u, rec in zip(point.keys, point.units, point.rec, strict=True):
+        v = np.asarray(rec, float) + e - centre
+        v = v - float(v @ p) * p
+        a = float(v @ u)
+        h = float(np.linalg.norm(v - a * u))
+        taus[key] = a + h * h / (2.0 * a) - half if a > 0.0 else -half
+        field_key = _bore_key(u, key, plane)
+        triggers[field_key] = _checked_trigger(field_key, taus[key] if field_key.endswith("+") else -taus[key],
+                                               probe, safe_area, point.diameter)
+    pairs = [-(taus[f"+{i}"] + taus[f"-{i}"]) for i in ("1", "2") if f"+{i}" in taus and f"-{i}" in taus]
+    d_eff = float(np.mean(pairs)) if with_ball and pairs else None
+    skew_mcs = rot_z(-spindle_angle) @ (e if wcs2bcs is None else wcs2bcs.dir_child2parent(e))
+    record = replace(probe, trigger={**probe.trigger, **triggers},
+                     skew=(float(skew_mcs[0]), float(skew_mcs[1])) if with_skew else probe.skew,
+                     effective_diameter=d_eff if d_eff is not None else probe.effective_diameter)
+    values: dict[str, Any] = {
+        "trigger": triggers,
+        "trigger_difference": {k: (None if k not in probe.trigger else v - float(probe.trigger[k]))
+                               for k, v in triggers.items()},
+        "angle": float(point.angle),
+        "skew": {"X": float(skew_mcs[0]), "Y": float(skew_mcs[1])} if with_skew else None,
+        "effective_diameter": d_eff,
+        "effective_diameter_difference": (None if d_eff is None or probe.effective_diameter <= 0.0
+                                          else d_eff - probe.effective_diameter),
+    }
+    if point.pass_centres is not None:
+        values["center"] = {plane.first: float(centre @ plane.unit(plane.first)),
+                            plane.second: float(centre @ plane.unit(plane.second))}
     return record, values
 
 

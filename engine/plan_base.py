@@ -106,6 +106,26 @@ class RingCalibrationPoint:
 
 
 @dataclass(frozen=True)
+class BoreCalibrationPoint:
+    """CYCLE976 in a bore along some directions (manual §5.3.1/§5.3.2, measuring-math §7.2–7.4).
+
+    ``keys`` name the directions "+1", "-1", "+2", "-2" (1st/2nd plane axis turned by ``angle``,
+    _STA1), in probing order; ``units`` their WCS travel directions; ``rec`` the raw recs (WCS,
+    no skew) of the final pass.
+    ``centre``: the known bore centre MP (the start), or None: unknown centre, then
+    ``pass_centres`` = (m180, m0), the raw centres of the passes at SPOS 180° and 0°.
+    """
+
+    diameter: float
+    angle: float
+    keys: tuple[str, ...]
+    units: tuple[FloatArray, ...]
+    rec: tuple[FloatArray, ...]
+    centre: FloatArray | None = None
+    pass_centres: tuple[FloatArray, FloatArray] | None = None
+
+
+@dataclass(frozen=True)
 class ToolTouch:
     """One tool-probe touch: tool tip (MCS) at switching; ``key`` = travel direction "Z-", "X+"."""
 

@@ -14,7 +14,14 @@ import numpy as np
 
 from engine.compensation import effective_radius, make_touch, parallel_axis, trigger_key
 from engine.evaluate import circle_from_touches, rect_from_touches
-from engine.plan_base import Motion, PlanContext, RingCalibrationPoint, RingPass, spindle
+from engine.plan_base import (
+    BoreCalibrationPoint,
+    Motion,
+    PlanContext,
+    RingCalibrationPoint,
+    RingPass,
+    spindle,
+)
 from engine.planes import Plane
 from engine.types import CirclePoint, EdgePoint, FloatArray, Latch, RectPoint, Step, Touch
 
@@ -321,6 +328,51 @@ def ring_program(params: dict[str, Any], start: FloatArray, ctx: PlanContext, la
         passes.append(as_pass(angle, latches))
     yield from m.move(found, f"{label} to centre")
     return RingCalibrationPoint(diameter=float(params["diameter"]), search=search, passes=tuple(passes))
+
+
+BORE_KEYS = ("+1", "-1", "+2", "-2")       # manual §5.3.1: + direction first, abscissa before ordinate
+
+
+def bore_units(plane: Plane, angle: float, keys: tuple[str, ...]) -> tuple[FloatArray, ...]:
+    """The travel directions of ``keys`` ("+1", "-2", ...): the plane axes turned by ``angle``
+    (_STA1; at an angle the order _STA1, _STA1+180°, _STA1+90°, _STA1+270°, measuring-math §7.1)."""
+    u1, u2 = plane_directions(plane, angle)
+    return tuple((1.0 if k[0] == "+" else -1.0) * (u1 if k[1] == "1" else u2) for k in keys)
+
+
+def bore_calibration_program(params: dict[str, Any], start: FloatArray, ctx: PlanContext, label: str
+                             ) -> Program[BoreCalibrationPoint]:
+    """CYCLE976 in a bore of diameter ``params["diameter"]`` along ``params["keys"]`` turned by
+    ``params["angle"]`` (manual §5.3.1/§5.3.2, measuring-math §7.2–7.4).
+
+    Known centre (``params["known_centre"]``): the start is MP; each direction is probed from it
+    and the probe returns to it. Unknown centre (4 directions): a pass at SPOS 180° and one at
+    SPOS 0° (+u1, −u1, to the found u1-centre, +u2, −u2, raw recs); the probe ends at the centre
+    of the 0° pass (the ball on the bore centre)."""
+    diameter = float(params["diameter"])
+    angle = float(params.get("angle", 0.0) or 0.0)
+    keys = tuple(params.get("keys") or BORE_KEYS)
+    units = bore_units(ctx.plane, angle, keys)
+    reach = diameter / 2.0 - ctx.probe.ball_diameter / 2.0
+    m = Motion(start, ctx)
+    if params.get("known_centre", True):
+        latches = []
+        for key, d in zip(keys, units, strict=True):
+            latches.append((yield from _inner_chord(m, m.start, d, reach, f"{label} {key}")))
+        yield from m.back(m.start)
+        return BoreCalibrationPoint(diameter, angle, keys, units, tuple(np.asarray(lt.rec, float).copy() for lt in latches),
+                                    centre=m.start.copy())
+    u1, u2 = units[0], units[2]
+    centres = []
+    for spos in (180.0, 0.0):
+        yield spindle(angle=spos, label=f"{label} SPOS {spos:g}")
+        latches4, found = yield from _pass(m, m.pos.copy(), u1, u2, _inner_chord, (reach, reach),
+                                           f"{label} SPOS {spos:g}", _raw_rec)
+        centres.append(found)
+        yield from m.move(found, f"{label} to centre")
+    recs = tuple(np.asarray(lt.rec, float).copy() for lt in latches4)
+    return BoreCalibrationPoint(diameter, angle, BORE_KEYS, bore_units(ctx.plane, angle, BORE_KEYS), recs,
+                                pass_centres=(centres[0], centres[1]))
 
 
 def _ring_program_n(params: dict[str, Any], start: FloatArray, ctx: PlanContext, label: str, n_dirs: int,

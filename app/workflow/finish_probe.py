@@ -17,7 +17,8 @@ from app.records import ProbeData
 from app.workflow.context import MeasuringContext
 from app.workflow.session import MeasureSession
 from engine import alarms
-from engine.calibration import calibrate_surface, evaluate_probe_task, probe_values
+from engine.calibration import calibrate_bore, calibrate_surface, evaluate_probe_task, probe_values
+from engine.compensation import skew_in_wcs
 from engine.types import MeasuringError, ProbeRecord
 
 # the ring passes could not tell whether the pre-travel turns with the spindle (engine.calibration)
@@ -148,6 +149,31 @@ def finish_probe_surface(session: MeasureSession, ctx: MeasuringContext, points:
     except ValueError as exc:
         raise MeasuringError(alarms.PROBE_NOT_SWITCHED, str(exc)) from exc
     n, record = _record(ctx, new, {"cal_height": setpoint, "cal_wo": ctx.active_offset})
+    values["probe"] = {**probe_values(new), **_calibration_view(record)}
+    answer = {"result": values, "correction": None, "activated": False, "setup_support": None}
+    return answer, {"offset": None, "probe_update": (n, record)}
+
+
+def finish_probe_bore(session: MeasureSession, ctx: MeasuringContext, points: list) -> tuple[dict, dict]:
+    """CYCLE976 in a bore along 1, 2 or 4 directions, axis-parallel or at _STA1 (manual §5.3.1,
+    §5.3.2; engine.calibration.calibrate_bore): the probed directions' trigger values, and the skew
+    and effective diameter when the variant asks for them; the other fields stay."""
+    probe = _probe_of(ctx)
+    params = session.params
+    point = points[0]
+    wcs2bcs = ctx.chain().wcs2bcs
+    # the stored skew where the touches were made: SPOS 0 after an unknown-centre calibration
+    spos = 0.0 if point.pass_centres is not None else float(ctx.spindle_angle)
+    try:
+        new, values = calibrate_bore(point, probe, ctx.plane, skew_wcs=skew_in_wcs(probe, wcs2bcs, spos),
+                                     with_skew=bool(params.get("skew")), with_ball=bool(params.get("ball")),
+                                     safe_area=params.get("safe_area"), wcs2bcs=wcs2bcs, spindle_angle=spos)
+    except ValueError as exc:
+        raise MeasuringError(alarms.PROBE_NOT_SWITCHED, str(exc)) from exc
+    extra: dict = {"cal_ring_diameter": float(params["diameter"]), "cal_wo": ctx.active_offset}
+    if params.get("skew"):
+        extra["calibrated_spindle_angle"] = 0.0
+    n, record = _record(ctx, new, extra)
     values["probe"] = {**probe_values(new), **_calibration_view(record)}
     answer = {"result": values, "correction": None, "activated": False, "setup_support": None}
     return answer, {"offset": None, "probe_update": (n, record)}

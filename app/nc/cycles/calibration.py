@@ -20,7 +20,7 @@ from app.nc.cycles.base import Call, CycleAlarm, digit, run_cycle, variant_error
 from app.workflow import finish_probe
 from app.workflow.tasks import TASKS, TaskSpec
 from engine import alarms
-from engine.plan_workpiece import surface_program
+from engine.plan_workpiece import bore_calibration_program, surface_program
 from engine.planes import Plane
 from engine.tasks import EngineTask, Family
 
@@ -56,6 +56,63 @@ SURFACE_CALIBRATION = dataclasses.replace(
     finish=finish_probe.finish_probe_surface, validator=None, planner=None)
 
 
+def _bore_params(params: dict, plane: Plane) -> dict:
+    """The cycle builds these itself from _MVAR, _MA, _MD, _STA1, _SETVAL (never operator input)."""
+    keys = ("diameter", "keys", "angle", "known_centre", "skew", "ball", "safe_area")
+    return {k: params[k] for k in keys if k in params}
+
+
+def _bore_program(params, n, start, ctx, label):
+    return bore_calibration_program(params, start, ctx, label)
+
+
+# CYCLE976 in a bore along 1, 2 or 4 directions, axis-parallel or at _STA1 (manual §5.3.1/§5.3.2)
+BORE_CALIBRATION = dataclasses.replace(
+    TASKS["probe.radius"], engine=EngineTask("probe.bore", Family.PROBE, 1, _bore_params, _bore_program),
+    finish=finish_probe.finish_probe_bore, validator=None, planner=None, circle_points=False)
+
+
+def _bore_keys(call: Call, directions: int) -> tuple[str, ...]:
+    """The directions of xx0x0x / xx1x0x (_MA, _MD) / xx2x0x (_MA), manual §5.3.1."""
+    if directions == 0:
+        return ("+1", "-1", "+2", "-2")
+    ma = call.integer("_MA")
+    if ma not in (1, 2):
+        raise CycleAlarm(alarms.MEASURING_AXIS, f"_MVAR={call.variant}: _MA = {ma}: the axis of 1 or 2 "
+                                                "directions is 1 (abscissa) or 2 (ordinate) (manual §5.3.1)")
+    if directions == 2:
+        return (f"+{ma}", f"-{ma}")
+    md = call.integer("_MD")
+    if md not in (0, 1):
+        raise CycleAlarm(alarms.NC_VALUE_RANGE, f"_MVAR={call.variant}: _MD = {md}: 0 positive, 1 negative "
+                                                "direction (manual §5.3.1)")
+    return (f"{'+' if md == 0 else '-'}{ma}",)
+
+
+def _bore_variant(call: Call, setval: float) -> tuple[TaskSpec, dict] | None:
+    """The bore variants xx0x01 / xx0x08 (digits: 3 ball, 4 directions, 5 skew, 6 angle, manual
+    §5.3 table); None for the 4-direction, axis-parallel one with ball and skew (the JOG ring)."""
+    v = call.variant
+    ball, directions, skew, angled = digit(v, 3), digit(v, 4), digit(v, 5), digit(v, 6)
+    if v >= 1_000_000 or digit(v, 2) != 0 or ball > 1 or directions > 2 or skew > 1 or angled > 1:
+        raise variant_error(call, "the bore variants are xx0x01 and xx0x08: digit 3 ball 0/1, digit 4 directions "
+                                  "0/1/2, digit 5 skew 0/1, digit 6 axis-parallel 0 / at the angle _STA1 1 "
+                                  "(manual §5.3)")
+    if digit(v, 1) == 8 and directions:
+        raise variant_error(call, "an unknown centre (xx0x08) is always calibrated in 4 directions (manual §5.3.2)")
+    if directions == 1 and (ball or skew):
+        raise variant_error(call, "one direction (xx1x0x) determines neither the skew nor the ball (manual §5.3)")
+    if not setval > 0.0:
+        raise CycleAlarm(alarms.NC_VALUE_RANGE, f"_SETVAL = {setval:g}: the ring diameter must be > 0 (manual §5.3.1)")
+    if (ball, directions, skew, angled) == (1, 0, 1, 0):
+        return None
+    keys = _bore_keys(call, directions)
+    angle = call.real("_STA1") if angled else 0.0
+    return BORE_CALIBRATION, {"diameter": setval, "keys": list(keys), "angle": angle,
+                              "known_centre": digit(v, 1) == 1, "skew": bool(skew), "ball": bool(ball),
+                              "safe_area": call.length("_TSA")}
+
+
 def _surface_variant(call: Call, setval: float) -> tuple[TaskSpec, dict]:
     ma, md = call.integer("_MA"), call.integer("_MD")
     if ma not in (1, 2, 3):
@@ -77,13 +134,13 @@ def _task976(call: Call, setval: float) -> tuple[TaskSpec, str, dict[str, object
         if call.integer("_MA") not in (0, 3):
             raise CycleAlarm(alarms.MEASURING_AXIS, "_MVAR=10000 calibrates the length in the applicate: _MA=3")
         return TASKS["probe.length"], "probe.length", {"setpoint": {call.plane.infeed: setval}}
-    if digit(v, 1) in (1, 8) and v < 1_000_000 and digit(v, 2) == 0 and digit(v, 6) == 0 and digit(v, 4) == 0:
-        if not setval > 0.0:
-            raise CycleAlarm(alarms.NC_VALUE_RANGE, f"_SETVAL = {setval:g}: the ring diameter must be > 0")
+    if digit(v, 1) in (1, 8):
+        bore = _bore_variant(call, setval)
+        if bore is not None:
+            return bore[0], "probe.bore", bore[1]
         return TASKS["probe.radius"], "probe.radius", {"diameter": setval}
     raise variant_error(call, "supported: 0 (one direction on a surface), 10000 (length on a surface) and "
-                              "the 4-direction bore variants "
-                              "(xx0x01, xx0x08; 1 or 2 directions and 'at an angle' are not supported)")
+                              "the bore variants xx0x01 (known centre) and xx0x08 (unknown centre) (manual §5.3)")
 
 
 def _results976(call: Call, task: str, result: dict, old) -> None:
@@ -118,6 +175,7 @@ def cycle976(call: Call) -> None:
     params["measurements"] = call.measurements()
     answer = call.run(env, spec, params, "measure_only")
     _results976(call, task, answer.get("result") or {}, old)
+    call.ovr[24] = float((answer.get("result") or {}).get("angle") or 0.0)    # _STA1 of a bore variant
     call.ovr[27] = call.out(call.length("_TZL"))
     call.ovr[28] = call.out(call.length("_TSA"))
 
