@@ -68,7 +68,7 @@ _NPTS = _int("_NPTS", N_("Number of points"), 0, 0, 36)
 
 CYCLES: dict[str, tuple[CycleField, ...]] = {
     "CYCLE976": (_VARIANT, _SETVAL, _AXIS, _int("_MD", N_("Measuring direction (0 +, 1 −)"), 1, 0, 1),
-                 *_COMMON, _real("_TZL", N_("Zero offset range"), 0.0, 0.0, 1e5)),
+                 _real("_STA1", N_("Starting angle")), *_COMMON, _real("_TZL", N_("Zero offset range"), 0.0, 0.0, 1e5)),
     "CYCLE977": (_VARIANT, _SETVAL, _real("_SETV[0]", N_("Setpoint length")), _real("_SETV[1]", N_("Setpoint width")),
                  _AXIS, _INFEED, _KNUM, _NPTS, *_COMMON, *_TOOL_OFFSET),
     "CYCLE978": (_VARIANT, _SETVAL, _AXIS, _KNUM, *_COMMON, *_TOOL_OFFSET),
