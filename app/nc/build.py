@@ -161,6 +161,8 @@ def bare_name(written: str, pos: n.Pos):
         # and PRESET (840D Fundamentals, "Frame suppression"): this control has none of those,
         # so SUPA is G53 here (manual listings §6: N30 SUPA G0 Z100)
         return n.GCode(53, pos)
+    if name in ("DIAMON", "DIAMOF"):        # diameter programming (lathe; refused by name on a mill)
+        return n.Diameter(name == "DIAMON", pos)
     if name in _STRUCTURED:
         raise NcSyntaxError(f"{name}: structured control statements are not part of this control's "
                             f"language (use IF ... GOTOF/GOTOB with labels)", *lc(pos))

@@ -248,6 +248,7 @@ class _Plan:
     tool_change: bool = False
     edge_word: tuple[n.Address, float] | None = None
     spindle: tuple[n.MCode, int] | None = None
+    diameter: n.Diameter | None = None
     motion_kind: str | None = None
     measurement: tuple[MeasureResult, Coordinates, int] | None = None
 
@@ -290,6 +291,7 @@ _EVALUATE: dict[type, Callable[[_Plan, Any], None]] = {
     n.Goto: lambda plan, w: setattr(plan, "goto", w),
     n.Msg: _eval_msg,
     n.GCode: _nothing, n.MCode: _nothing, n.Stopre: _nothing,
+    n.Diameter: lambda plan, w: setattr(plan, "diameter", w),
 }
 
 
@@ -394,7 +396,7 @@ class Interpreter:
             if self._state == _RUNNING:
                 raise NcStateError("a program is running: stop it before loading another")
         if isinstance(program, str):
-            refuse_out_of_scope(program)
+            refuse_out_of_scope(program, self.lathe)
         parsed = parse_program(program, name) if isinstance(program, str) else program
         try:
             self.variables.define_locals(_local_definitions(parsed, self.variables))
@@ -594,6 +596,8 @@ class Interpreter:
             new = new.replace(offset=gcodes[OFFSET].name)
             offset = new.offset
             self._located(gcodes[OFFSET], lambda: self.runtime.offset_chain(offset))   # it must exist
+        if plan.diameter is not None:
+            new = new.replace(diamon=plan.diameter.on)
         plan.new = new
         plan.suppress = 53 in {g.number for g in plan.block.gcodes()}
 
@@ -617,7 +621,9 @@ class Interpreter:
             word, value = plan.address["T"]
             t = _whole(value, word, "T", self)
             plan.new = plan.new.replace(preselected=t if t > 0 else None)
-        plan.tool_change = M_TOOL_CHANGE in plan.mcodes
+        # the lathe's turret: T changes the tool at once (840D lathe, manual ch. 6: "N10 T7 D1");
+        # the milling machine: T preselects, M6 changes
+        plan.tool_change = M_TOOL_CHANGE in plan.mcodes or (self.lathe and "T" in plan.address)
         plan.edge_word = plan.address.get("D")
         new = plan.new
         if plan.tool_change:
@@ -630,7 +636,7 @@ class Interpreter:
             new = new.replace(edge=d)
         plan.new = new
         if new.tool != plan.before.tool or new.edge != plan.before.edge:
-            where = plan.edge_word[0] if plan.edge_word else plan.mcodes[M_TOOL_CHANGE]
+            where = plan.edge_word[0] if plan.edge_word else self._tool_change_word(plan)
             self._located(where, lambda: self.runtime.tool_length(new.tool, new.edge))
 
     def _check_spindle(self, plan: _Plan) -> None:
@@ -686,11 +692,15 @@ class Interpreter:
     def _command_tool(self, plan: _Plan) -> None:
         new = plan.new
         if plan.tool_change:
-            self._located(plan.mcodes[M_TOOL_CHANGE], lambda: self.runtime.change_tool(new.tool, new.edge))
+            self._located(self._tool_change_word(plan), lambda: self.runtime.change_tool(new.tool, new.edge))
             self._modal = self._modal.replace(tool=new.tool, edge=new.edge, preselected=new.preselected)
         elif plan.edge_word is not None and new.edge != plan.before.edge:
             self._located(plan.edge_word[0], lambda: self.runtime.select_edge(new.edge))
             self._modal = self._modal.replace(edge=new.edge)
+
+    @staticmethod
+    def _tool_change_word(plan: _Plan):
+        return plan.mcodes[M_TOOL_CHANGE] if M_TOOL_CHANGE in plan.mcodes else plan.address["T"][0]
 
     def _command_spos(self, plan: _Plan) -> None:
         spos = plan.spos
@@ -710,7 +720,11 @@ class Interpreter:
         if plan.motion_kind == "G100":
             plan.new = plan.new.replace(measuring=self._g100(plan.ev, plan.new, plan.axis_values))
         elif plan.motion_kind is not None:
-            plan.measurement = self._motion(plan.new, plan.suppress, plan.axis_values, plan.meas, plan.motion_kind)
+            axis_values = plan.axis_values
+            if plan.new.diamon and "X" in axis_values:     # DIAMON: X is a diameter (G90 and G91 alike)
+                word, value = axis_values["X"]
+                axis_values = {**axis_values, "X": (word, value / 2.0)}
+            plan.measurement = self._motion(plan.new, plan.suppress, axis_values, plan.meas, plan.motion_kind)
 
     # --- commit, then the cycle and the program flow ---------------------------------------------------
     def _commit(self, plan: _Plan) -> None:
@@ -746,6 +760,11 @@ class Interpreter:
     # --- motion ------------------------------------------------------------------------------------
     def _coordinates(self, modal: ModalState, suppress: bool) -> Coordinates:
         frame = Frame.identity() if suppress else self.runtime.offset_chain(modal.offset).wcs2bcs
+        if self.lathe:
+            # the lathe: tip = F − (L1·x̂ + L2·ẑ) (turning.md §0.1), X a radius
+            active = modal.tool is not None and modal.edge > 0
+            l1, l2 = self.runtime.lathe_lengths() if active else (0.0, 0.0)
+            return Coordinates(frame, 1.0, np.array([float(l1), 0.0, float(l2)]))
         length = 0.0
         if modal.tool is not None and modal.edge > 0:
             length = float(self.runtime.tool_length(modal.tool, modal.edge))
@@ -873,6 +892,16 @@ class Interpreter:
         tool, edge = self.runtime.tool_state()
         preselected = tool if self._modal.preselected is None else self._modal.preselected
         self._modal = self._modal.replace(offset=offset, tool=tool, edge=edge, preselected=preselected)
+        if self.lathe:      # the lathe's reset state: G18, DIAMON as the machine is set up (turning.md §0.3)
+            self._modal = self._modal.replace(
+                plane="G18" if self._modal.plane == "G17" else self._modal.plane,
+                diamon=bool(getattr(self.runtime, "diameter_programming", False)))
+
+    @property
+    def lathe(self) -> bool:
+        """The machine is a lathe (runtime ``is_lathe``): the turret changes with T, the tool
+        offset is L1 on X and L2 on Z, DIAMON/DIAMOF and the lathe cycles (manual ch. 6) run."""
+        return bool(getattr(self.runtime, "is_lathe", False))
 
     def _bind_system_variables(self) -> None:
         v = self.variables
@@ -884,7 +913,8 @@ class Interpreter:
             coords = self._coordinates(self._modal, False)
             pos = self.runtime.position()
             if key in GEOMETRY_AXES:
-                return float(coords.tip_wcs(pos)[GEOMETRY_AXES.index(key)])
+                value = float(coords.tip_wcs(pos)[GEOMETRY_AXES.index(key)])
+                return 2.0 * value if key == "X" and self._modal.diamon else value
             return coords.rotary_wcs(key, pos[key]) if key in pos else None
 
         bindings = {
@@ -912,8 +942,10 @@ class Interpreter:
         if isinstance(w, n.AxisWord) and w.axis not in axes:
             raise NcSyntaxError(f"{w.axis}: this machine has no axis {w.axis} (axes: {' '.join(sorted(axes))})",
                                 w.pos.line, w.pos.column, alarm=alarms.NC_NAME_UNKNOWN)
-        if isinstance(w, n.CycleCall) and w.name not in self.cycles:
-            raise NcSyntaxError(refusal(w.name) or (f"{w.name} is not a cycle of this control"
+        if isinstance(w, n.Diameter) and not self.lathe:
+            raise NcSyntaxError(refusal(w.name) or w.name, w.pos.line, w.pos.column, alarm=alarms.NC_NAME_UNKNOWN)
+        if isinstance(w, n.CycleCall) and (w.name not in self.cycles or refusal(w.name, self.lathe)):
+            raise NcSyntaxError(refusal(w.name, self.lathe) or (f"{w.name} is not a cycle of this control"
                                 + (f" (known: {', '.join(sorted(self.cycles))})" if self.cycles else "")),
                                 w.pos.line, w.pos.column, alarm=alarms.NC_NAME_UNKNOWN)
         if isinstance(w, n.Assign):

@@ -95,6 +95,7 @@ class ModalState:
     edge: int = 0
     preselected: int | None = None
     measuring: MeasuringOffsets = field(default_factory=MeasuringOffsets)
+    diamon: bool = False                  # DIAMON: X words (and the lathe cycles' X values) are diameters
 
     def replace(self, **changes) -> ModalState:
         return replace(self, **changes)
@@ -131,4 +132,5 @@ class ModalState:
             "spindle": {1: "M3", -1: "M4", 0: "M5"}[self.spindle_direction],
             "spindle_speed": self.spindle_speed, "tool": self.tool, "edge": self.edge,
             "preselected": self.preselected, "measuring_offsets": self.measuring.to_dict(),
+            "diamon": self.diamon,
         }

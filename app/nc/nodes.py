@@ -155,6 +155,18 @@ class Stopre:
 
 
 @dataclass(frozen=True)
+class Diameter:
+    """DIAMON (``on``) / DIAMOF: X values as diameters or radii (840D G group 29; a lathe only)."""
+
+    on: bool
+    pos: Pos
+
+    @property
+    def name(self) -> str:
+        return "DIAMON" if self.on else "DIAMOF"
+
+
+@dataclass(frozen=True)
 class IfGoto:
     condition: Expr
     goto: Goto

@@ -38,7 +38,7 @@ from .modal import (
     MOTION,
     g_group,
 )
-from .scope import OUT_OF_SCOPE, refusal
+from .scope import LATHE_WORDS, OUT_OF_SCOPE, refusal
 
 #: how a terminal is named in an error message
 _TERMINAL_WORDS = {
@@ -207,20 +207,22 @@ def _scan_line(line: str, number: int) -> None:
 _OUT_OF_SCOPE = re.compile(r"(?<![$\w])(" + "|".join(re.escape(w) for w in OUT_OF_SCOPE) + r")(?!\w)", re.IGNORECASE)
 
 
-def refuse_out_of_scope(text: str) -> None:
+def refuse_out_of_scope(text: str, lathe: bool = False) -> None:
     """A word of the manual this control does not run (app.nc.scope) names itself, wherever it
     stands in the program, before any other complaint (``CYCLE800(1,““,...)`` of manual §5.7.2):
-    what ``Interpreter.load`` checks first; the grammar itself still reads such words."""
+    what ``Interpreter.load`` checks first; the grammar itself still reads such words. ``lathe``:
+    the machine is a lathe, which runs the words of ``scope.LATHE_WORDS``."""
     upper = text.upper()
-    if not any(word in upper for word in OUT_OF_SCOPE):        # the usual case: one pass per word, no regex
+    words = [w for w in OUT_OF_SCOPE if not (lathe and w in LATHE_WORDS)]
+    if not any(word in upper for word in words):        # the usual case: one pass per word, no regex
         return
     for number, line in enumerate(text.replace("\r\n", "\n").replace("\r", "\n").split("\n"), start=1):
         if line.lstrip().startswith("%"):
             continue
         code = line.split(";", 1)[0].split("\uff1b", 1)[0]
-        match = _OUT_OF_SCOPE.search(code)
+        match = next((m for m in _OUT_OF_SCOPE.finditer(code) if refusal(m.group(0), lathe)), None)
         if match is not None:
-            raise NcSyntaxError(refusal(match.group(0)) or match.group(0), number, match.start() + 1,
+            raise NcSyntaxError(refusal(match.group(0), lathe) or match.group(0), number, match.start() + 1,
                                 alarm=alarms.NC_NAME_UNKNOWN, block_text=line.strip())
 
 

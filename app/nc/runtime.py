@@ -83,3 +83,7 @@ class NcRuntime(Protocol):
 
     def spindle_position(self, angle: float) -> None:
         """SPOS: orient the (stopped) spindle to ``angle`` degrees."""
+
+    def lathe_lengths(self) -> tuple[float, float]:
+        """A lathe only (an ``is_lathe`` property that is true): the effective (L1, L2) of the tool
+        in the turret; the tip is F − (L1·x̂ + L2·ẑ) (turning.md §0.1)."""

@@ -5,14 +5,16 @@ word, before anything moves), never with a bare "unknown name" (issue 28 item 1)
 
 from __future__ import annotations
 
-_LATHE = ("a measuring cycle of the lathe (manual ch. 6) that this control's NC does not run (on the milling "
-          "machine and on the lathe alike): measure on the lathe with the lathe tasks of the JOG screens")
+_LATHE = ("a word of the lathe (manual ch. 6): this machine is a milling machine; the NC runs it on a lathe "
+          "(machine kind \"lathe\")")
+
+#: the words of manual ch. 6 the NC runs on a lathe (app.nc.cycles.lathe, DIAMON/DIAMOF in the
+#: interpreter) and refuses by name on the milling machine
+LATHE_WORDS = frozenset({"DIAMON", "DIAMOF", "CYCLE982", "CYCLE973", "CYCLE974", "CYCLE994"})
 
 OUT_OF_SCOPE: dict[str, tuple[str, str]] = {
-    "DIAMON": ("§6", "diameter programming of the lathe (manual ch. 6) is not part of this control's NC: "
-                     "programs give X as a radius coordinate, on the lathe too"),
-    "DIAMOF": ("§6", "diameter programming off (lathe, manual ch. 6) is not part of this control's NC: "
-                     "programs always give X as a radius coordinate, on the lathe too"),
+    "DIAMON": ("§6", f"diameter programming is {_LATHE}"),
+    "DIAMOF": ("§6", f"diameter programming off is {_LATHE}"),
     "CYCLE982": ("§6.2–6.3", f"tool measuring on the lathe is {_LATHE}"),
     "CYCLE973": ("§6.4", f"calibrating the workpiece probe on the lathe is {_LATHE}"),
     "CYCLE974": ("§6.5", f"1-point measuring on the lathe is {_LATHE}"),
@@ -31,10 +33,11 @@ OUT_OF_SCOPE: dict[str, tuple[str, str]] = {
 }
 
 
-def refusal(word: str) -> str | None:
-    """The operator's text for a word of the manual this control refuses, or None."""
+def refusal(word: str, lathe: bool = False) -> str | None:
+    """The operator's text for a word of the manual this control refuses, or None (``lathe``: the
+    machine is a lathe, which runs the words of ``LATHE_WORDS``)."""
     entry = OUT_OF_SCOPE.get(str(word).upper())
-    if entry is None:
+    if entry is None or lathe and str(word).upper() in LATHE_WORDS:
         return None
     section, why = entry
     return f"{word} (manual {section}): {why}"

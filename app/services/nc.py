@@ -156,6 +156,21 @@ class MachineRuntime:
         self.offset_chain(name)
         self._checked(lambda: self._ms.activate(name))
 
+    @property
+    def is_lathe(self) -> bool:
+        """A lathe: the interpreter runs the words of manual ch. 6 (app.nc.scope.LATHE_WORDS)."""
+        return bool(self._ms.is_lathe)
+
+    @property
+    def diameter_programming(self) -> bool:
+        """The lathe's DIAMON after Reset (the machine's setting, turning.md §0.3)."""
+        return bool(self._ms.diameter_programming)
+
+    def lathe_lengths(self) -> tuple[float, float]:
+        """The NC's effective (L1, L2) of the tool in the turret (geometry + wear)."""
+        l1, l2 = getattr(self._machine.status(), "tool_lengths", (0.0, 0.0))
+        return float(l1), float(l2)
+
     def tool_state(self) -> tuple[int | None, int]:
         tool = self._machine.status().tool
         return tool, (self._edge if tool is not None else 0)
@@ -223,7 +238,11 @@ class NcMeasuringEnv:
 
     def measuring_context(self):
         ctx = self._base.measuring_context(probe_number=self._settings.get("probe_record"))
-        return dataclasses.replace(ctx, plane=self._plane, settings=self._gud(ctx.settings))
+        extra = ctx.extra
+        if "diamon" in self._settings and "lathe" in (extra or {}):
+            # the program's DIAMON/DIAMOF, not the machine's default (manual ch. 6)
+            extra = {**extra, "lathe": {**extra["lathe"], "diamon": bool(self._settings["diamon"])}}
+        return dataclasses.replace(ctx, plane=self._plane, settings=self._gud(ctx.settings), extra=extra)
 
     def commit_measurement(self, *, log_entry: dict, **commit):
         entry = dict(log_entry)
@@ -354,7 +373,7 @@ class NcService:
         text = block.text.strip()
         log_extra = {"program": self._source or MDA, "block": (f"L{block.line}: {text}")[:200],
                      "cycle": _json_ready({**cycle, "block": block.number, "line": block.line})}
-        return _CycleMeasuring(NcMeasuringEnv(self._env, ctx.modal.plane, settings, log_extra),
+        return _CycleMeasuring(NcMeasuringEnv(self._env, settings.get("plane", ctx.modal.plane), settings, log_extra),
                                on_workflow=self._set_cycle_workflow)
 
     def _set_cycle_workflow(self, workflow: WorkflowService) -> None:
