@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import re
 import socket
-from typing import Any
+from typing import Any, TypeGuard
 
 from app import checks
 from app.errors import InvalidInput, NotFoundError
@@ -213,71 +213,120 @@ def _material(task: str, name: str, result: dict) -> int | None:
     return None
 
 
+def _is_number(value: object) -> TypeGuard[int | float]:
+    return isinstance(value, int | float) and not isinstance(value, bool)
+
+
 def _values(task: str, params: dict, result: dict, zero_offset: bool) -> list[tuple[str, str, float, float | None]]:
-    """(name, result key, actual, nominal) of the entry's result values."""
-    out: list[tuple[str, str, float, float | None]] = []
+    """(name, result key, actual, nominal) of the entry's result values: the sizes, and without a
+    zero offset corrected also the positions and the angles."""
+    out = _size_values(params, result)
+    if zero_offset:
+        return out
     setpoint: dict = params["setpoint"] if isinstance(params.get("setpoint"), dict) else {}
+    if task == "edge.set":
+        out += _edge_values(params, result, setpoint)
+    else:
+        out += _position_values(result, setpoint)
+    return out + _angle_values(params, result)
+
+
+def _size_values(params: dict, result: dict) -> list[tuple[str, str, float, float | None]]:
+    out: list[tuple[str, str, float, float | None]] = []
     for key in SIZES:
         value = result.get(key)
-        if isinstance(value, int | float) and not isinstance(value, bool):
+        if _is_number(value):
             nominal = params.get(key) if key != "distance" else params.get("setpoint")
             out.append((key, key, float(value), nominal if isinstance(nominal, int | float) else None))
-    if task == "edge.set" and isinstance(result.get("position"), dict) and not zero_offset:
-        axis = params.get("axis")
-        value = result["position"].get(axis)
-        if isinstance(value, int | float):
-            given = params.get("setpoint")            # a number (the edge's position) or {axis: value}
-            nominal = given if isinstance(given, int | float) and not isinstance(given, bool) else setpoint.get(axis)
-            out.append((f"position {axis}", "position", float(value), nominal))
-    elif not zero_offset and task != "edge.set":
-        for key in POSITIONS:
-            point = result.get(key)
-            if isinstance(point, dict):
-                for axis, value in point.items():
-                    if isinstance(value, int | float) and not isinstance(value, bool):
-                        out.append((f"{key} {axis}", key, float(value), setpoint.get(axis)))
-    if not zero_offset:
-        for key in ANGLES:
-            value = result.get(key)
-            if isinstance(value, int | float) and not isinstance(value, bool):
-                nominal = params.get("setpoint_angle", 0.0) if key == "angle" else 0.0
-                out.append((key, key, float(value), nominal if isinstance(nominal, int | float) else None))
     return out
+
+
+def _edge_values(params: dict, result: dict, setpoint: dict) -> list[tuple[str, str, float, float | None]]:
+    """The edge's position on its axis."""
+    if not isinstance(result.get("position"), dict):
+        return []
+    axis = params.get("axis")
+    value = result["position"].get(axis)
+    if not isinstance(value, int | float):
+        return []
+    given = params.get("setpoint")            # a number (the edge's position) or {axis: value}
+    nominal = given if _is_number(given) else setpoint.get(axis)
+    return [(f"position {axis}", "position", float(value), nominal)]
+
+
+def _position_values(result: dict, setpoint: dict) -> list[tuple[str, str, float, float | None]]:
+    out: list[tuple[str, str, float, float | None]] = []
+    for key in POSITIONS:
+        point = result.get(key)
+        if isinstance(point, dict):
+            out += [(f"{key} {axis}", key, float(value), setpoint.get(axis))
+                    for axis, value in point.items() if _is_number(value)]
+    return out
+
+
+def _angle_values(params: dict, result: dict) -> list[tuple[str, str, float, float | None]]:
+    out: list[tuple[str, str, float, float | None]] = []
+    for key in ANGLES:
+        value = result.get(key)
+        if _is_number(value):
+            nominal = params.get("setpoint_angle", 0.0) if key == "angle" else 0.0
+            out.append((key, key, float(value), nominal if isinstance(nominal, int | float) else None))
+    return out
+
+
+def _entry_parts(entry: dict) -> tuple[str, dict, dict]:
+    """(task, params, result) of a log entry, empty where the entry has none."""
+    params: dict = entry["params"] if isinstance(entry.get("params"), dict) else {}
+    result: dict = entry["result"] if isinstance(entry.get("result"), dict) else {}
+    return str(entry.get("task") or ""), params, result
+
+
+def _name_prefix(params: dict) -> str:
+    """The characteristic's name the operator gave, with a space before the value's name."""
+    prefix = params.get("characteristic")
+    return f"{prefix} " if isinstance(prefix, str) and prefix.strip() else ""
 
 
 def characteristics_of(entry: dict, job_limits: dict, settings: GudSettings) -> list[dict]:
     """The characteristics of one log entry (docs/results.md): each result value with its nominal,
     its band (the job's limits by name; else the tolerance object of design.md §9.3 for the value
     it applies to) and its verdict."""
-    task = str(entry.get("task") or "")
-    params: dict = entry["params"] if isinstance(entry.get("params"), dict) else {}
-    result: dict = entry["result"] if isinstance(entry.get("result"), dict) else {}
+    task, params, result = _entry_parts(entry)
     target = entry.get("target")
     tool_target = isinstance(params.get("target"), dict) or (isinstance(target, str) and target.startswith("T"))
     zero_offset = not (tool_target or target in (None, "measure_only"))
     tolerance = params.get("tolerance") if isinstance(params.get("tolerance"), dict) else None
-    prefix = params.get("characteristic")
-    prefix = f"{prefix} " if isinstance(prefix, str) and prefix.strip() else ""
+    banded = tolerance is not None or tool_target         # the tolerance object (or a tool's) applies
+    prefix = _name_prefix(params)
+    toleranced = TOLERANCED.get(task, ())
     out = []
     for name, key, actual, nominal in _values(task, params, result, zero_offset):
         given = job_limits.get(prefix + name)
-        if key not in SIZES and key not in TOLERANCED.get(task, ()) and not given:
+        if key not in SIZES and key not in toleranced and not given:
             continue            # a position or angle has no band unless the job gives one
-        upper = lower = None
-        if key in TOLERANCED.get(task, ()) and (tolerance is not None or tool_target):
-            tol = tolerance or {}
-            if key in SIZES and tol.get("setpoint") is not None and key in ("diameter", "distance"):
-                nominal = float(tol["setpoint"])
-            if nominal is not None:
-                upper = nominal + float(tol.get("upper", settings.tol_upper))
-                lower = nominal + float(tol.get("lower", settings.tol_lower))
-        if given:
-            nominal = given["nominal"] if given.get("nominal") is not None else nominal
-            upper, lower = given.get("upper"), given.get("lower")
-        deviation = actual - nominal if nominal is not None else None
-        compensation = result.get("compensation") if key in TOLERANCED.get(task, ()) else None
+        tol = (tolerance or {}) if key in toleranced and banded else None
+        nominal, upper, lower = _band(key, nominal, tol, given, settings)
+        compensation = result.get("compensation") if key in toleranced else None
         out.append({"name": prefix + name, "nominal": nominal, "upper": upper, "lower": lower, "actual": actual,
-                    "deviation": deviation, "unit": "deg" if key in ANGLES else "mm",
+                    "deviation": actual - nominal if nominal is not None else None,
+                    "unit": "deg" if key in ANGLES else "mm",
                     "verdict": verdict(actual, lower, upper, _material(task, key, result), settings.verdict_rule),
                     "compensation": compensation if isinstance(compensation, int | float) and compensation else None})
     return out
+
+
+def _band(key: str, nominal: float | None, tol: dict | None, given: dict | None,
+          settings: GudSettings) -> tuple[float | None, float | None, float | None]:
+    """(nominal, upper, lower) of a value: from the job's limits ``given`` by name, else from the
+    tolerance object ``tol`` where it applies to the value (None where it does not)."""
+    upper = lower = None
+    if tol is not None:
+        if key in SIZES and tol.get("setpoint") is not None and key in ("diameter", "distance"):
+            nominal = float(tol["setpoint"])
+        if nominal is not None:
+            upper = nominal + float(tol.get("upper", settings.tol_upper))
+            lower = nominal + float(tol.get("lower", settings.tol_lower))
+    if given:
+        nominal = given["nominal"] if given.get("nominal") is not None else nominal
+        upper, lower = given.get("upper"), given.get("lower")
+    return nominal, upper, lower
