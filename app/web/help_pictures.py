@@ -82,7 +82,7 @@ def _edge(task: str, p: dict, plane: Plane) -> Picture:
     if axis == plane.infeed:                               # side view: the probe above the top face
         pic = Picture(plane, side=True)
         pic.add('<rect class="help-part" x="60" y="80" width="120" height="50"/>')
-        pic.probe(120, 40, "start")
+        pic.probe(120, 40, gettext("start"))
         pic.touch(1, 120, 80, 0.0, 1.0, axis, "-")
         pic.p0(150, 80, f"{axis}0")
         return pic
@@ -110,7 +110,7 @@ def _edge(task: str, p: dict, plane: Plane) -> Picture:
         ys = (55, 100) if task == "edge.align" else (75,)
         for n, y in enumerate(ys, 1):
             pic.touch(n, face, y, dx, dy, axis, sign)
-        pic.probe(face - 30 * dx, ys[0], "start")
+        pic.probe(face - 30 * dx, ys[0], gettext("start"))
         if task == "edge.set":
             pic.p0(face, 120, f"{axis}0")
     else:
@@ -119,7 +119,7 @@ def _edge(task: str, p: dict, plane: Plane) -> Picture:
         xs = (80, 160) if task == "edge.align" else (120,)
         for n, x in enumerate(xs, 1):
             pic.touch(n, x, face, dx, dy, axis, sign)
-        pic.probe(xs[0], face - 30 * dy, "start")
+        pic.probe(xs[0], face - 30 * dy, gettext("start"))
         if task == "edge.set":
             pic.p0(190, face, f"{axis}0")
     return pic
@@ -230,7 +230,7 @@ def _plane_align(plane: Plane) -> Picture:
 def _probe_length(plane: Plane) -> Picture:
     pic = Picture(plane, side=True)
     pic.add('<rect class="help-part" x="50" y="95" width="140" height="35"/>')
-    pic.probe(120, 55, "probe")
+    pic.probe(120, 55, gettext("probe"))
     pic.touch(1, 120, 95, 0.0, 1.0, plane.infeed, "-")
     note = gettext("calibration height %(axis)s", axis=plane.infeed)
     pic.add(f'<text class="help-note" x="140" y="90">{escape(note)}</text>')

@@ -68,3 +68,15 @@ def test_the_equipment_is_shown_where_it_is_used(page, api):
     expect(page.locator('#task-help [data-equipment="Tool probe"]')).to_contain_text(f"disc Ø {disc:.3f} mm")
     assert directions(page) == {"P1": "-Z"}
     api.put("/api/settings", json={"cal_ring_diameter": 0.0})
+
+
+def test_the_picture_speaks_chinese_and_german_with_the_manuals_terms(page, api):
+    """The ring calibration's picture in Chinese: the label and caption use the manual's 钻孔中心
+    (seed 001 line 5107) and carry no English; in German the edge picture's start label is "Start"."""
+    page.goto("/measure/workpiece/calibrate/radius?lang=zh")
+    figure = page.locator("#task-help figure.help-picture")
+    expect(figure.locator("svg .help-probe text")).to_have_text("钻孔中心")
+    expect(figure.locator("figcaption")).to_contain_text("大约定位在钻孔中心和校准深度处")
+    page.goto("/measure/workpiece/edge/set?lang=de")
+    expect(page.locator("#task-help svg .help-probe text")).to_have_text("Start")
+    page.goto("/measure/workpiece/edge/set?lang=en")
