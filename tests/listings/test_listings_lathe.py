@@ -16,7 +16,16 @@ import json
 from pathlib import Path
 
 import pytest
-from manual_listings import KALIBRIEREN_IN_NUT_20537, NV_ERMITTLUNG_1_21058
+from manual_listings import (
+    INKR_KALIBRIEREN_19596,
+    INKR_MESSEN_20039,
+    KALIBRIEREN_IN_NUT_20537,
+    KALIBRIEREN_IN_Z_20714,
+    KALIBRIEREN_MTWZ_16812,
+    KALIBRIEREN_MTWZ_WKS_17856,
+    NV_ERMITTLUNG_1_21058,
+    T3_MESSEN_17138,
+)
 
 SCENARIO = json.loads((Path(__file__).resolve().parents[2] / "app" / "machine" / "lathe_demo_scenario.json")
                       .read_text(encoding="utf-8"))
@@ -28,6 +37,8 @@ GROOVE = SCENARIO["grooves"][0]["sl7"]
 SHAFT = next(p for p in SCENARIO["workpiece"]["profile"] if p["type"] == "cylinder")
 BORE = next(p for p in SCENARIO["workpiece"]["profile"] if p["type"] == "bore")
 FACE_Z = SHAFT["z"][1]                                        # the shaft's end face (MCS, chuck face at 0)
+FACES = SCENARIO["tool_probe"]["faces"]                        # the tool probe's true faces (MCS of the tip)
+TOOLS = {t["t"]: t for t in SCENARIO["tools"]}
 NOISE = 1e-6                                                  # noise_sigma 0: the simulator's exact switch
 
 
@@ -64,6 +75,21 @@ class Lathe:
     def put_g54(self, x: float = 0.0, z: float = 0.0) -> None:
         self.ok(self.c.put("/api/offsets/G54", json={"trans": {"X": x, "Y": 0.0, "Z": z},
                                                      "rot": {"X": 0.0, "Y": 0.0, "Z": 0.0}}))
+
+    def tool_probe(self) -> dict:
+        return self.ok(self.c.get("/api/tool-probes/1"))
+
+    def tool(self, t: int) -> dict:
+        return self.ok(self.c.get(f"/api/tools/{t}"))
+
+    def tip_to(self, t: int, x: float, z: float) -> None:
+        """The operator turns the turret to T``t`` and jogs its tip (stored L1/L2) to MCS (x, z):
+        up and away first, then Z, then X."""
+        self.ok(self.c.post("/api/machine/tool", json={"tool": t}))
+        row = self.tool(t)
+        l1, l2 = row["l1"] + row["wear"]["l1"], row["l2"] + row["wear"]["l2"]
+        for axes in ({"Z": 800.0}, {"X": 600.0}, {"Z": z + l2}, {"X": x + l1}):
+            self.ok(self.c.post("/api/machine/goto", json={**axes, "coords": "MCS"}))
 
     def g54(self) -> dict[str, float]:
         frame = self.ok(self.c.get("/api/offsets/G54"))
@@ -114,3 +140,101 @@ def test_6_5_2_zero_offset_from_the_face(lathe):
     assert lathe.var("_OVI")[:4] == [1, 0, 974, 100]
     # N50/N60 positioned with DIAMON: the probe ends at WCS X114 (Ø), i.e. radius 57
     assert lathe.ok(lathe.c.get("/api/machine"))["wcs"]["X"] == pytest.approx(114.0)
+
+
+# --- CYCLE982: the tool probe and the turning tools (§6.2, §6.3) ----------------------------------------
+
+# §6.2.2's positions on this lathe (MCS of T7's tip, X a radius): start above and right of the
+# tool probe, then beside it (X350), below it (Z170), away (X350, Z520) -- the positions §6.2.4 prints
+MTWZ_POSITIONS = {"Z300 X240": "Z240 X420", "SUPA Z60": "SUPA Z240", "SUPA X20": "SUPA X350", "SUPA Z0": "SUPA Z170",
+                  "SUPA X240": "SUPA X350", "SUPA  Z300": "SUPA  Z520"}
+
+
+def test_6_2_2_tool_probe_calibrated_machine_related(lathe):
+    """§6.2.2 %_N_KALIBRIEREN_MTWZ_MPF (lines 16812–16835): CYCLE982 _MVAR=0 with the calibration
+    tool T7, −X, −Z, +X, +Z: _TP holds the tool probe's true faces (stored 400/220/380/200, the
+    rough values). Adapted: the positions (MTWZ_POSITIONS)."""
+    assert lathe.tool_probe()["trigger"] == {"Z-": 220.0, "Z+": 200.0, "X-": 400.0, "X+": 380.0}
+    lathe.run(KALIBRIEREN_MTWZ_16812, replace=MTWZ_POSITIONS)
+    assert lathe.tool_probe()["trigger"] == pytest.approx(FACES, abs=NOISE)
+    ovr = lathe.var("_OVR")
+    # the manual's _OVR of the calibration: [8] Z−, [10] Z+, [12] X−, [14] X+, [11] the last one's difference
+    assert [ovr[8], ovr[10], ovr[12], ovr[14]] == pytest.approx([FACES["Z-"], FACES["Z+"], FACES["X-"], FACES["X+"]],
+                                                               abs=NOISE)
+    assert ovr[11] == pytest.approx(FACES["Z+"] - 200.0, abs=NOISE)
+    assert lathe.var("_OVI")[2:4] == [982, 0]
+
+
+def test_6_2_4_tool_probe_calibrated_then_t3_measured_into_the_wear(lathe):
+    """§6.2.4 %_N_T3_MESSEN_MPF (lines 17138–17175) as printed (its positions fit this lathe):
+    the tool probe calibrated with T7, then T3 measured with _MVAR=1 _CHBIT[3]=1 (into the wear)
+    in −X (L1) and −Z (L2). Truth: T3's true L1/L2 minus its stored nominal ones."""
+    lathe.run(T3_MESSEN_17138)
+    assert lathe.tool_probe()["trigger"] == pytest.approx(FACES, abs=NOISE)
+    row = lathe.tool(3)
+    true, nominal = TOOLS[3], TOOLS[3]["nominal"]
+    assert (row["l1"], row["l2"]) == (nominal["l1"], nominal["l2"])
+    assert row["wear"]["l1"] == pytest.approx(true["l1"] - nominal["l1"], abs=NOISE)
+    assert row["wear"]["l2"] == pytest.approx(true["l2"] - nominal["l2"], abs=NOISE)
+    ovr = lathe.var("_OVR")
+    assert ovr[10] == pytest.approx(true["l2"], abs=NOISE)              # the last call: L2 actual, difference
+    assert ovr[11] == pytest.approx(true["l2"] - nominal["l2"], abs=NOISE)
+    assert ovr[29] == pytest.approx(0.8)                                 # _TDIF
+    assert lathe.var("_OVI")[2:4] == [982, 1] and lathe.var("_OVI")[8] == 3
+
+
+def test_6_3_2_tool_probe_calibrated_workpiece_related(lathe):
+    """§6.3.2 %_N_KALIBRIEREN_MTWZ_WKS_MPF (lines 17856–17880): CYCLE982 _MVAR=10 in G54: _TPW
+    holds the faces in G54 (Z shifted by G54's 20), _TP stays. Adapted: the positions (those of
+    §6.2.4 in G54); the operator entered rough _TPW values first."""
+    lathe.put_g54(z=20.0)
+    lathe.ok(lathe.c.put("/api/tool-probes/1", json={"workpiece_trigger": {"Z-": 200.0, "Z+": 180.0, "X-": 400.0,
+                                                                             "X+": 380.0}}))
+    tp_before = lathe.tool_probe()["trigger"]
+    lathe.run(KALIBRIEREN_MTWZ_WKS_17856, replace={
+        "Z100 X120": "Z220 X420", "G0 Z80": "G0 Z220", "G0 X10": "G0 X350", "G0 Z-10": "G0 Z150", "G0  X10": "G0  X350",
+        "N70 Z100": "N70 Z500", "N80 X120": "N80 X420"})
+    record = lathe.tool_probe()
+    expected = {k: v - (20.0 if k[0] == "Z" else 0.0) for k, v in FACES.items()}
+    assert record["workpiece_trigger"] == pytest.approx(expected, abs=NOISE)
+    assert record["trigger"] == tp_before
+    assert lathe.var("_OVI")[2:4] == [982, 10]
+
+
+def test_6_3_5_and_6_3_6_incremental_calibration_and_measurement(lathe):
+    """§6.3.5 %_N_INKR_KALIBRIEREN_MPF (lines 19596–19606): _MVAR=100000 _MA=2 _MD=1 from where the
+    operator put T7 (20 mm right of the X− face, at the probe's height): _TP X− is the true face;
+    §6.3.6 %_N_INKR_MESSEN_MPF (lines 20039–20049): _MVAR=100001 with T3 the same way: its L1
+    (geometry, _CHBIT[3]=0) becomes the true one. Adapted: the print lost §6.3.6's "；" before
+    N10's comment (seed line 20040)."""
+    lathe.tip_to(7, 415.0, 210.0)
+    lathe.run(INKR_KALIBRIEREN_19596)
+    trigger = lathe.tool_probe()["trigger"]
+    assert trigger["X-"] == pytest.approx(FACES["X-"], abs=NOISE)
+    assert trigger["Z-"] == 220.0                                       # the other faces stay
+    lathe.tip_to(3, 415.0, 210.0)
+    lathe.run(INKR_MESSEN_20039, replace={"G94  车刀": "G94  ；车刀"})
+    row = lathe.tool(3)
+    assert row["l1"] == pytest.approx(TOOLS[3]["l1"], abs=NOISE) and row["wear"]["l1"] == 0.0
+    assert row["l2"] == TOOLS[3]["nominal"]["l2"]
+    ovr = lathe.var("_OVR")
+    assert ovr[8] == pytest.approx(TOOLS[3]["l1"], abs=NOISE)
+    assert ovr[9] == pytest.approx(TOOLS[3]["l1"] - TOOLS[3]["nominal"]["l1"], abs=NOISE)
+
+
+# --- CYCLE973 on a surface (§6.4.3) ---------------------------------------------------------------------
+
+def test_6_4_3_probe_calibrated_on_the_face(lathe):
+    """§6.4.3 %_N_KALIBRIEREN_IN_Z_MPF (lines 20714–20727): DIAMON, CYCLE973 _MVAR=0 _SETVAL=−18
+    _MA=1 _MD=1: the shaft's end face lies at G54 Z−18 (G54 Z = FACE_Z + 18): _WP Z− is the
+    true ball radius. Adapted: T9 → T8 (this lathe's probe), X66 → X40 (Ø, on the face)."""
+    lathe.rough_probe_record()
+    lathe.put_g54(z=FACE_Z + 18.0)
+    lathe.run(KALIBRIEREN_IN_Z_20714, replace={"T9 D1": "T8 D1", "X66": "X40"})
+    record = lathe.ok(lathe.c.get("/api/probes/1"))
+    assert record["trigger"]["Z-"] == pytest.approx(R_TRUE, abs=NOISE)
+    assert record["trigger"]["X-"] == PROBE["nominal"]["ball_diameter"] / 2.0       # not this call's
+    ovr = lathe.var("_OVR")
+    assert ovr[8] == pytest.approx(R_TRUE, abs=NOISE)
+    assert ovr[9] == pytest.approx(R_TRUE - PROBE["nominal"]["ball_diameter"] / 2.0, abs=NOISE)
+    assert lathe.ok(lathe.c.get("/api/machine"))["wcs"]["X"] == pytest.approx(146.0)   # N50 X146 (Ø)
