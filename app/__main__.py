@@ -9,6 +9,7 @@ the access subcommands (design.md §9.2) work on the database:
     python -m app [--db PATH] token list | token delete NAME
     python -m app [--db PATH] keyswitch [POSITION]          (show or turn the simulated keyswitch)
     python -m app [--db PATH] opcua trust add|list|remove CERT  (the OPC UA client certificates trusted)
+    python -m app [--db PATH] [--scenario PATH] commissioning [--json]  (the start-up checks of manual ch. 9-10)
 
 Without users the HMI is the stand-alone trainer and binds only to loopback: a ``--host`` other than
 loopback is refused until a user exists.
@@ -55,7 +56,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                         help="with --opcua: add the umati MachineTool instance (loaded in the background)")
     parser.add_argument("--mtconnect", type=int, default=None, metavar="PORT",
                         help="also serve an MTConnect SHDR adapter at HOST:PORT for an MTConnect agent")
-    commands = parser.add_subparsers(dest="command", metavar="{user,token,keyswitch,opcua}",
+    commands = parser.add_subparsers(dest="command", metavar="{user,token,keyswitch,opcua,commissioning}",
                                      help="access administration (without one: serve the HMI)")
     user = commands.add_parser("user", help="users who sign in with a password (levels 1-3)")
     user_cmd = user.add_subparsers(dest="action", required=True)
@@ -83,7 +84,37 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     trust = opcua_cmd.add_parser("trust", help="trust add CERT | trust list | trust remove THUMBPRINT|FILE")
     trust.add_argument("trust_action", choices=("add", "list", "remove"))
     trust.add_argument("cert", nargs="?", help="add: a certificate file (DER or PEM); remove: thumbprint or file")
+    commissioning = commands.add_parser(
+        "commissioning", help="the start-up checks of the measuring cycles (manual ch. 9-10); exit 1 when one fails")
+    commissioning.add_argument("--json", action="store_true", help="print GET /api/commissioning/checks' answer")
     return parser.parse_args(argv)
+
+
+def run_commissioning_command(args: argparse.Namespace, settings: Settings) -> int:
+    """``commissioning``: each check of app.services.commissioning on the machine of ``--scenario``
+    and the database's settings; one line per check, or the API's JSON; 1 when one fails."""
+    import json
+
+    from app.main import build_services
+    from app.services.commissioning import CommissioningService
+    from app.services.scenarios import read_scenario
+
+    services = build_services(settings, read_scenario(settings))
+    try:
+        report = CommissioningService(services).report()
+    finally:
+        if services.nc is not None:
+            services.nc.close()
+        services.machine.close()
+        services.db.close()
+    if args.json:
+        print(json.dumps(report, ensure_ascii=False, indent=1))
+    else:
+        for check in report["checks"]:
+            state = {True: "ok  ", False: "FAIL", None: "--  "}[check["ok"]]
+            print(f"{state} {check['section']:<7} {check['item']:<36} {check['value']!s:<14} {check['rule']}")
+        print(f"{len(report['checks']) - report['failed']} of {len(report['checks'])} checks passed")
+    return 0 if report["ok"] else 1
 
 
 def run_trust_command(args: argparse.Namespace, settings: Settings) -> int:
@@ -248,6 +279,8 @@ def main(argv: list[str] | None = None) -> None:
         settings = settings_from_args(args)
         if args.command == "opcua":
             sys.exit(run_trust_command(args, settings))
+        if args.command == "commissioning":
+            sys.exit(run_commissioning_command(args, settings))
         if args.command:
             sys.exit(run_access_command(args, settings))
         refusal = refuse_open_trainer(settings)

@@ -48,3 +48,27 @@ def test_bad_port_is_refused():
     result = subprocess.run([sys.executable, "-m", "app", "--port", "abc"], cwd=ROOT, capture_output=True,
                             text=True, timeout=60)
     assert result.returncode == 2 and "--port" in result.stderr
+
+
+def test_commissioning_command_fails_on_a_wrong_machine_datum(tmp_path):
+    """``python -m app commissioning``: MD 18130 = 100 (manual §9.1.1: 130 with "Measure in JOG")
+    fails that check only, exit 1; the commissioned scenario passes every check, exit 0."""
+    import json
+
+    from hmi_testdata import test_scenario
+
+    def run(machine_data: dict, *extra: str):
+        scenario = test_scenario()
+        scenario.setdefault("machine", {})["machine_data"] = machine_data
+        path = tmp_path / f"s{len(machine_data)}.json"
+        path.write_text(json.dumps(scenario))
+        return subprocess.run([sys.executable, "-m", "app", "--db", str(tmp_path / "c.db"), "--scenario", str(path),
+                               "commissioning", *extra], cwd=ROOT, capture_output=True, text=True, timeout=120)
+
+    wrong = run({"18130": 100}, "--json")
+    assert wrong.returncode == 1, wrong.stderr
+    report = json.loads(wrong.stdout)
+    assert [c["id"] for c in report["checks"] if c["ok"] is not True] == ["md18130"]
+    right = run({})
+    assert right.returncode == 0, right.stdout + right.stderr
+    assert "FAIL" not in right.stdout and "MD 18130 MM_NUM_GUD_NAMES_CHAN" in right.stdout

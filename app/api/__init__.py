@@ -16,6 +16,7 @@ from app.access.deps import guard
 
 from . import (
     access,
+    commissioning,
     cycles,
     data,
     events,
@@ -61,7 +62,7 @@ ERRORS: dict[int | str, dict[str, Any]] = {"4XX": {"model": ErrorEnvelope, "desc
 api_router = APIRouter(prefix="/api", generate_unique_id_function=operation_id, dependencies=[Depends(guard)],
                        responses=ERRORS)
 for module in (machine, data, measure, setup_support, plc, access, nc, programs, cycles, lathe, events, results, probe_test, plant,
-               kinematics):
+               kinematics, commissioning):
     for route in module.router.routes:
         if isinstance(route, APIRoute) and route.summary is None:
             route.summary = route.endpoint.__name__.replace("_", " ").title()    # FastAPI's default

@@ -237,6 +237,14 @@ class KinematicData(Protocol):
 
 
 @runtime_checkable
+class MachineData(Protocol):
+    """Optional: a control whose machine data the HMI can read (manual ch. 9): MD number (text,
+    "18118") -> value, a list for an array datum (app.machine.machine_data)."""
+
+    def machine_data(self) -> dict[str, Any]: ...
+
+
+@runtime_checkable
 class Lathe(Protocol):
     """Optional: a lathe (turning.md §10.2): X in MCS is a radius, with DIAMON the control shows and
     takes it as a diameter; the tools sit in a turret and their lengths L1/L2 come from the NC's

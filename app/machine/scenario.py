@@ -14,6 +14,7 @@ from typing import Annotated, Literal, TypeVar
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from .lathe_scenario import LatheScenario
+from .machine_data import check_machine_data
 from .polygon import check_simple_polygon, polygon_area
 from .probe_signal import Radio
 
@@ -163,6 +164,14 @@ class MachineConfig(_Model):
     # the spindle's axis (design.md §9.8): the tool points along −spindle_axis from the spindle
     # nose (tip = A − L·axis); "Y"/"X" = a horizontal spindle (physics.SPINDLE_MOUNTS)
     spindle_axis: Literal["Z", "Y", "X"] = "Z"
+    # the control's machine data as commissioned (app.machine.machine_data, manual ch. 9): MD number
+    # -> value; the ones not given have the values the measuring cycles need
+    machine_data: dict[str, float | list[float]] = Field(default_factory=dict)
+
+    @field_validator("machine_data")
+    @classmethod
+    def _machine_data_ok(cls, value: dict) -> dict:
+        return check_machine_data(value)
 
     @model_validator(mode="after")
     def _spindle_and_head(self) -> MachineConfig:

@@ -36,6 +36,7 @@ from engine import alarms
 from .alarm_book import AlarmBook
 from .checks import finite, positive
 from .kinematics import XYZ
+from .machine_data import machine_data
 from .motion import Motion
 from .probe_signal import ProbeSignals
 from .protocol import ActiveFrame, Alarm, MachineAlarm, MachineBusy, MoveResult, ProbeResult
@@ -89,6 +90,11 @@ class SimulatedControl:
     @property
     def scenario(self) -> Any:
         return self._scenario
+
+    # --- machine data (MachineData, manual ch. 9) ---------------------------------------------
+    def machine_data(self) -> dict[str, Any]:
+        """MD number -> value: as commissioned for the measuring cycles, with the scenario's own."""
+        return machine_data(getattr(self._scenario.machine, "machine_data", None))
 
     @property
     def axes(self) -> tuple[str, ...]:

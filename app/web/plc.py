@@ -10,6 +10,8 @@ from fastapi import APIRouter, Form, Request
 from app.access.deps import needs
 from app.deps import PlcDep, ServicesDep
 from app.errors import HmiError
+from app.i18n import gettext
+from app.services.commissioning import CommissioningService
 from app.services.plc import MEANINGS
 from app.services.readiness import ReadinessService
 
@@ -27,9 +29,15 @@ def _readiness_ctx(services) -> dict:
     return {"readiness": ReadinessService(services).report()}
 
 
+def _commissioning_ctx(services) -> dict:
+    """The start-up checks of manual ch. 9–10 with their rules in the operator's language."""
+    return {"commissioning": [(c, c.rule_text(gettext)) for c in CommissioningService(services).checks()]}
+
+
 @router.get("/plc", name="plc_screen")
 def plc_screen(request: Request, services: ServicesDep):
-    return render_screen(request, "plc.html", {"screen": "plc", **_byte_ctx(services), **_readiness_ctx(services)})
+    return render_screen(request, "plc.html", {"screen": "plc", **_byte_ctx(services), **_readiness_ctx(services),
+                                               **_commissioning_ctx(services)})
 
 
 @router.get("/plc/db19", name="plc_db19")

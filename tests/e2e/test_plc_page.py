@@ -64,3 +64,18 @@ def test_manual_release_shows_each_handshake_step(page, api):
     finally:
         api.put("/api/plc/db19/mode", json={"auto_release": True})
         api.put("/api/plc/db19/dbb43", json={"bit": 0, "value": False})
+
+
+def test_commissioning_section_shows_a_wrong_machine_datum_in_chinese(page, api):
+    """The control commissioned with MD 18130 = 100 (manual §9.1.1: 130 with "Measure in JOG"): its
+    row fails with the rule in the operator's language, the others pass."""
+    scenario = {**TEST_SCENARIO, "machine": {**TEST_SCENARIO.get("machine", {}), "machine_data": {"18130": 100}}}
+    assert api.post("/api/sim/scenario", json={**scenario, "reset_data": True}).status_code == 200
+    page.goto("/plc?lang=zh")
+    row = page.locator('#commissioning [data-commissioning="md18130"]')
+    expect(row).to_have_attribute("data-ok", "no")
+    expect(row).to_contain_text("至少 130")
+    expect(row).to_contain_text("未通过")
+    expect(page.locator('#commissioning [data-ok="no"]')).to_have_count(1)
+    expect(page.locator('#commissioning [data-commissioning="md28082"]')).to_contain_text("§9.1.1")
+    page.goto("/plc?lang=en")
