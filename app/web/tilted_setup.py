@@ -53,38 +53,11 @@ def steps_model(services) -> dict:
     machine = services.machine
     plane = machine.plane()
     chain_wo = support.chain_wo(services.db)
+    swivel = machine.has_swivel()
     entries = _log_since(services.log, int(state.get("since", 0))) if target else []
-
-    def find(pred, after: int = 0) -> dict | None:
-        return next((e for e in entries if e["id"] > after and pred(e)), None)
-
-    plane_entry = find(lambda e: e["task"] == "plane.align" and e.get("target") == target)
-    s1 = plane_entry is not None
-    s2 = s1 and chain_wo == target and machine.active_offset == target
-    aligned = None
-    if s2 and machine.has_swivel():
-        status = machine.status()
-        chain = machine.chain.wcs2bcs
-        infeed = chain.dir_child2parent(plane.infeed_unit)
-        aligned = abs(float(sum(a * b for a, b in zip(status["tool_axis"], infeed, strict=True))) - 1.0) < 1e-9
-    after_plane = plane_entry["id"] if plane_entry else 0
-    corner = find(lambda e: e["task"] in ("corner.right", "edge.align") and e.get("target") == target
-                  and _measuring_wo(e) == target, after_plane) if s2 else None
-    edge = find(lambda e: e["task"] == "edge.set" and (e.get("params") or {}).get("axis") == plane.infeed
-                and e.get("target") == target and _measuring_wo(e) == target,
-                corner["id"] if corner else 0) if corner else None
-    done = [s1, s2, corner is not None, edge is not None]
-    steps = [
-        {"n": 1, "label": "Orient plane", "detail": f"measure the top face under G500, Zero offset = {target}",
-         "task": "plane.align"},
-        {"n": 2, "label": "Activate" + (" + re-align probe" if machine.has_swivel() else ""),
-         "detail": "set-up support: NC Start activates the WO" + (
-             " and swivels the probe perpendicular to the new plane" if machine.has_swivel() else
-             " (no swivel on this machine: the probe stays as it is)"), "task": "setup-support"},
-        {"n": 3, "label": "Right-angled corner (or Align edge) in the tilted plane",
-         "detail": f"measuring WO = {target}", "task": "corner.right"},
-        {"n": 4, "label": f"Set edge {plane.infeed}", "detail": f"measuring WO = {target}", "task": "edge.set"},
-    ]
+    done = _done(entries, target, plane, activated=chain_wo == target and machine.active_offset == target)
+    aligned = _aligned(machine, plane) if done[1] and swivel else None
+    steps = _steps(target, plane, swivel)
     current = next((i + 1 for i, d in enumerate(done) if not d), None)
     for step, is_done in zip(steps, done, strict=True):
         step["done"] = is_done
@@ -92,9 +65,50 @@ def steps_model(services) -> dict:
     offset = services.offsets.list().get(target) if target else None
     return {"target": target, "steps": steps, "complete": all(done) and target is not None,
             "current": current, "chain_wo": chain_wo, "active": machine.active_offset,
-            "aligned": aligned, "swivel": machine.has_swivel(), "offset": offset,
+            "aligned": aligned, "swivel": swivel, "offset": offset,
             "translation": dict(zip("XYZ", Frame.from_api(offset).translation, strict=True)) if offset else None,
             "targets": [n for n in services.offsets.names() if n.startswith("G5")]}
+
+
+def _done(entries: list[dict], target, plane, *, activated: bool) -> list[bool]:
+    """Which of the four steps are done, from the log entries since the set-up started (each step
+    after the one before it)."""
+
+    def find(pred, after: int = 0) -> dict | None:
+        return next((e for e in entries if e["id"] > after and pred(e)), None)
+
+    def in_target(e: dict) -> bool:
+        return e.get("target") == target and _measuring_wo(e) == target
+
+    plane_entry = find(lambda e: e["task"] == "plane.align" and e.get("target") == target)
+    s1 = plane_entry is not None
+    s2 = s1 and activated
+    after_plane = plane_entry["id"] if plane_entry else 0
+    corner = find(lambda e: e["task"] in ("corner.right", "edge.align") and in_target(e), after_plane) if s2 else None
+    edge = find(lambda e: e["task"] == "edge.set" and (e.get("params") or {}).get("axis") == plane.infeed
+                and in_target(e), corner["id"]) if corner else None
+    return [s1, s2, corner is not None, edge is not None]
+
+
+def _aligned(machine, plane) -> bool:
+    """Whether the tool axis stands perpendicular to the active WO's plane."""
+    status = machine.status()
+    infeed = machine.chain.wcs2bcs.dir_child2parent(plane.infeed_unit)
+    return abs(float(sum(a * b for a, b in zip(status["tool_axis"], infeed, strict=True))) - 1.0) < 1e-9
+
+
+def _steps(target, plane, swivel: bool) -> list[dict]:
+    return [
+        {"n": 1, "label": "Orient plane", "detail": f"measure the top face under G500, Zero offset = {target}",
+         "task": "plane.align"},
+        {"n": 2, "label": "Activate" + (" + re-align probe" if swivel else ""),
+         "detail": "set-up support: NC Start activates the WO" + (
+             " and swivels the probe perpendicular to the new plane" if swivel else
+             " (no swivel on this machine: the probe stays as it is)"), "task": "setup-support"},
+        {"n": 3, "label": "Right-angled corner (or Align edge) in the tilted plane",
+         "detail": f"measuring WO = {target}", "task": "corner.right"},
+        {"n": 4, "label": f"Set edge {plane.infeed}", "detail": f"measuring WO = {target}", "task": "edge.set"},
+    ]
 
 
 def _render(request: Request, notice: str = ""):
