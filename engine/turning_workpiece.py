@@ -258,71 +258,105 @@ def finish_workpiece(call: WorkpieceCall, m: WorkpieceMeasurement, ctx: LatheCon
     """
     chk = check_workpiece(call, ctx, target)
     ovr, ovi = ovr_list(), ovi_list()
-    slot = {"Z": 0, "X": 1, "Y": 2}[m.axis]
-    start_disp = {a: (2.0 * float(m.start[j]) if is_diameter(a, ctx.diamon, m.y_like_x) else float(m.start[j]))
-                  for a, j in (("Z", 2), ("X", 0), ("Y", 1))}
     values: dict[str, Any] = {"actual": m.actual, "setpoint": m.setpoint, "difference": m.difference,
                     "deviation": m.deviation, "axis": m.axis, "unit": "diameter" if m.diameter else "radius"}
-    frame_before = frame_after = fix = None
-    tool_before = tool_after = None
-    quantity = None
-    c = 0.0
     if m.zero_offset:
-        decision, shift = zero_offset_decision(call, m)
-        if not call.knum:                                   # _KNUM=0: measure only [L20956–L20978]
-            decision, shift = "none", 0.0
-        axis = frame_axis(m)
-        c = shift
-        fix = FeatureFix(position={axis: m.surface}, point=None)
-        if frame is not None and call.knum:
-            fine = bool(ctx.fine_offset) and not ctx.bit(21) and int(call.knum) != 2000     # MM turning §2.1
-            frame_before, frame_after = zero_offset_update(frame.get("coarse", (0, 0, 0)), frame.get("fine", (0, 0, 0)),
-                                                           axis, shift, fine_mode=fine)
-        values.update({"decision": decision, "compensation": shift, "frame_axis": axis,
-                       "setpoint_radius": m.setpoint * m.scale})
-        if frame_after is not None:
-            values["frame"] = {"before": frame_before, "after": frame_after}
-        ovr[0], ovr[4], ovr[16], ovr[28], ovr[30] = m.setpoint, m.actual, m.difference, float(call.tsa), m.ev
-        ovr[1 + slot], ovr[5 + slot], ovr[17 + slot] = m.setpoint, m.actual, m.difference
-        ovi[0], ovi[11] = int(call.knum), 1 if call.knum else 0
+        done = _zero_offset_correction(call, m, ctx, frame, values, ovr, ovi)
     else:
-        if decision not in DECISIONS:
-            raise ValueError(f"decision must be one of {', '.join(DECISIONS)}, got {decision!r}")
-        tgt = chk.target
-        if decision in ("none", "dimension_difference", "safe_area"):
-            amount = 0.0
-        if tgt is not None:
-            quantity = tgt.resolve(m.axis, m.y_like_x)
-            if amount:
-                c = correction_value(amount, scale=m.scale, radius=quantity == "radius", direction=m.direction,
-                                     two_point=m.cycle == 994, inside=m.inside, inverse=tgt.inverse)
-            if tool is not None and c != 0.0:
-                tool_before, tool_after = workpiece_tool_update(tool, quantity, c, tgt)
-        values.update({"decision": decision, "compensation": c, "quantity": quantity})
-        if mean_value is not None:
-            values["mean_value"] = mean_value
-        if tool_after is not None:
-            values["tool"] = {"before": tool_before, "after": tool_after}
-        ovr[0], ovr[4], ovr[8], ovr[12], ovr[16] = m.setpoint_eff, m.actual, m.upper_eff, m.lower_eff, m.difference
-        if m.cycle == 994:
-            ovr[1 + slot], ovr[5 + slot] = m.setpoint_eff, m.actual
-        else:                            # [I] the start position with the setpoint / actual on _MA
-            for a, i in (("Z", 0), ("X", 1), ("Y", 2)):
-                ovr[1 + i] = ovr[5 + i] = start_disp[a]
-            ovr[1 + slot], ovr[5 + slot] = m.setpoint_eff, m.actual
-        ovr[17 + slot] = m.difference
-        ovr[20] = c
-        ovr[27], ovr[28], ovr[29], ovr[30] = float(call.tzl), float(call.tsa), float(call.tdif), m.ev
-        ovr[31] = float(mean_value or 0.0)
-        ovi[0] = tgt.d if tgt is not None else 0
-        ovi[4] = int(call.k)
-        ev_no, mv_no = ev_mv_numbers(call.evnum)
-        ovi[6], ovi[7] = (mv_no, ev_no) if call.evnum else (0, 0)
-        ovi[8] = tgt.t if tgt is not None else int(call.tnum or 0)
+        done = _tool_correction(call, m, ctx, chk.target, decision, amount, mean_value, tool, values, ovr, ovi)
     ovi[2], ovi[3], ovi[5] = call.cycle, call.mvar, int(call.prnum)
     ovi[9] = warning.number if warning is not None else 0
     if warning is not None:
         values["alarm"] = warning.number
-    return WorkpieceResult(values=values, ovr=tuple(ovr), ovi=tuple(ovi), compensation=c, quantity=quantity,
-                           tool_before=tool_before, tool_after=tool_after, frame_before=frame_before,
-                           frame_after=frame_after, fix=fix, alarm=warning)
+    return WorkpieceResult(values=values, ovr=tuple(ovr), ovi=tuple(ovi), compensation=done.compensation,
+                           quantity=done.quantity, tool_before=done.tool_before, tool_after=done.tool_after,
+                           frame_before=done.frame_before, frame_after=done.frame_after, fix=done.fix,
+                           alarm=warning)
+
+
+_SLOTS = {"Z": 0, "X": 1, "Y": 2}        # an axis's place in _OVR's groups of three
+
+
+@dataclass(frozen=True)
+class _Correction:
+    """What a decision changed: the compensation value c and the tool or frame update."""
+
+    compensation: float = 0.0
+    quantity: str | None = None
+    tool_before: dict[str, Any] | None = None
+    tool_after: dict[str, Any] | None = None
+    frame_before: dict[str, Any] | None = None
+    frame_after: dict[str, Any] | None = None
+    fix: FeatureFix | None = None
+
+
+def _zero_offset_correction(call: WorkpieceCall, m: WorkpieceMeasurement, ctx: LatheContext,
+                            frame: Mapping[str, Any] | None, values: dict[str, Any], ovr: list[float],
+                            ovi: list[int]) -> _Correction:
+    """974 _MVAR=100: the decision, the frame update (when ``frame`` is given) and _OVR/_OVI."""
+    decision, shift = zero_offset_decision(call, m)
+    if not call.knum:                                   # _KNUM=0: measure only [L20956–L20978]
+        decision, shift = "none", 0.0
+    axis = frame_axis(m)
+    slot = _SLOTS[m.axis]
+    frame_before = frame_after = None
+    if frame is not None and call.knum:
+        fine = bool(ctx.fine_offset) and not ctx.bit(21) and int(call.knum) != 2000     # MM turning §2.1
+        frame_before, frame_after = zero_offset_update(frame.get("coarse", (0, 0, 0)), frame.get("fine", (0, 0, 0)),
+                                                       axis, shift, fine_mode=fine)
+    values.update({"decision": decision, "compensation": shift, "frame_axis": axis,
+                   "setpoint_radius": m.setpoint * m.scale})
+    if frame_after is not None:
+        values["frame"] = {"before": frame_before, "after": frame_after}
+    ovr[0], ovr[4], ovr[16], ovr[28], ovr[30] = m.setpoint, m.actual, m.difference, float(call.tsa), m.ev
+    ovr[1 + slot], ovr[5 + slot], ovr[17 + slot] = m.setpoint, m.actual, m.difference
+    ovi[0], ovi[11] = int(call.knum), 1 if call.knum else 0
+    return _Correction(compensation=shift, frame_before=frame_before, frame_after=frame_after,
+                       fix=FeatureFix(position={axis: m.surface}, point=None))
+
+
+def _tool_correction(call: WorkpieceCall, m: WorkpieceMeasurement, ctx: LatheContext, tgt: ToolTarget | None, decision: str | None,
+                     amount: float, mean_value: float | None, tool: LatheTool | Mapping[str, Any] | None,
+                     values: dict[str, Any], ovr: list[float], ovi: list[int]) -> _Correction:
+    """974 0/1000, 994: the strategy's decision applied to the tool data of ``tgt``; _OVR/_OVI."""
+    if decision not in DECISIONS:
+        raise ValueError(f"decision must be one of {', '.join(DECISIONS)}, got {decision!r}")
+    if decision in ("none", "dimension_difference", "safe_area"):
+        amount = 0.0
+    c = 0.0
+    quantity = None
+    tool_before = tool_after = None
+    if tgt is not None:
+        quantity = tgt.resolve(m.axis, m.y_like_x)
+        if amount:
+            c = correction_value(amount, scale=m.scale, radius=quantity == "radius", direction=m.direction,
+                                 two_point=m.cycle == 994, inside=m.inside, inverse=tgt.inverse)
+        if tool is not None and c != 0.0:
+            tool_before, tool_after = workpiece_tool_update(tool, quantity, c, tgt)
+    values.update({"decision": decision, "compensation": c, "quantity": quantity})
+    if mean_value is not None:
+        values["mean_value"] = mean_value
+    if tool_after is not None:
+        values["tool"] = {"before": tool_before, "after": tool_after}
+    _tool_ovr(call, m, ctx, c, mean_value, ovr)
+    ovi[0] = tgt.d if tgt is not None else 0
+    ovi[4] = int(call.k)
+    ev_no, mv_no = ev_mv_numbers(call.evnum)
+    ovi[6], ovi[7] = (mv_no, ev_no) if call.evnum else (0, 0)
+    ovi[8] = tgt.t if tgt is not None else int(call.tnum or 0)
+    return _Correction(compensation=c, quantity=quantity, tool_before=tool_before, tool_after=tool_after)
+
+
+def _tool_ovr(call: WorkpieceCall, m: WorkpieceMeasurement, ctx: LatheContext, c: float, mean_value: float | None,
+              ovr: list[float]) -> None:
+    slot = _SLOTS[m.axis]
+    ovr[0], ovr[4], ovr[8], ovr[12], ovr[16] = m.setpoint_eff, m.actual, m.upper_eff, m.lower_eff, m.difference
+    if m.cycle != 994:                   # [I] the start position with the setpoint / actual on _MA
+        for a, j, i in (("Z", 2, 0), ("X", 0, 1), ("Y", 1, 2)):
+            ovr[1 + i] = ovr[5 + i] = (2.0 * float(m.start[j]) if is_diameter(a, ctx.diamon, m.y_like_x)
+                                       else float(m.start[j]))
+    ovr[1 + slot], ovr[5 + slot] = m.setpoint_eff, m.actual
+    ovr[17 + slot] = m.difference
+    ovr[20] = c
+    ovr[27], ovr[28], ovr[29], ovr[30] = float(call.tzl), float(call.tsa), float(call.tdif), m.ev
+    ovr[31] = float(mean_value or 0.0)

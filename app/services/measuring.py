@@ -218,56 +218,74 @@ class MeasuringEnv:
     def _commit(self, offset, log_entry, probe_update, tool_update, tool_probe_update, tool_offset, source,
                 kinematics_update=None):
         entry = {k: v for k, v in log_entry.items() if k in LOG_FIELDS}
-        outcome = stored_offset = stored_tool = None
+        outcome = stored_offset = None
         generation = self._db.generation
         with self._db.unit() as unit:
             if offset is not None:
-                outcome = offset.compute(self._frames_in(unit, generation))
-                wrong = frame_out_of_range(outcome.after)
-                if wrong:
-                    raise InvalidInput(f"The measured correction would make {offset.target} {wrong[1]}: "
-                                       "check the setpoints and the probe data", field=wrong[0],
-                                       code="correction_out_of_range")
-                try:
-                    self._ms.check_holds(offset.target, outcome.after)
-                except AlarmError:
-                    if entry.get("task") == TILT_TASK:
-                        self._unaligned_tilt = (offset.target, tilt_deg(outcome.after))
-                    raise
-                if entry.get("task") == TILT_TASK:
-                    self._unaligned_tilt = None
-                _before, after = unit.put_offset(offset.target, outcome.after, source="measure",
-                                                 detail=outcome.detail)
-                stored_offset = (offset.target, after)
-                entry["correction"] = outcome.answer.get("correction")
+                outcome, stored_offset = self._store_offset(unit, offset, generation, entry)
             detail = {"task": entry.get("task")}
             if tool_offset is not None:
                 outcome = self._tool_offset(unit, tool_offset, entry)
                 if outcome.after is not None:
                     tool_update = (outcome.tool, outcome.after)
-            if probe_update is not None:
-                record = self._calibrated(unit, "workpiece", probe_update[0], probe_update[1], entry)
-                unit.put_probe(probe_update[0], record, source=source, detail=detail)
-            if tool_update is not None:
-                stored_tool = unit.put_tool(tool_update[0], tool_update[1], source=source, detail=detail)
-            if tool_probe_update is not None:
-                record = self._calibrated(unit, "tool", tool_probe_update[0], tool_probe_update[1], entry)
-                unit.put_tool_probe(tool_probe_update[0], record, source=source, detail=detail)
+            stored_tool = self._store_records(unit, entry, source, detail, probe_update, tool_update,
+                                              tool_probe_update)
             log_id = self.results.add_log(unit, entry) if self.results is not None else unit.add_log(entry)
             lines = self._kinematics_audit(unit, kinematics_update, log_id)
         log_entry["calibration_id"] = entry.get("calibration_id")     # a calibration's new id, for the answer
+        self._write_nc(generation, lines, stored_offset, stored_tool,
+                       records=bool(probe_update or tool_update or tool_probe_update))
+        return log_id, outcome
+
+    def _store_offset(self, unit, offset, generation: int, entry: dict):
+        """The corrected WO stored in ``unit`` once it is in range and the machine can hold it:
+        (the outcome, (WO name, stored frame))."""
+        outcome = offset.compute(self._frames_in(unit, generation))
+        wrong = frame_out_of_range(outcome.after)
+        if wrong:
+            raise InvalidInput(f"The measured correction would make {offset.target} {wrong[1]}: "
+                               "check the setpoints and the probe data", field=wrong[0],
+                               code="correction_out_of_range")
+        try:
+            self._ms.check_holds(offset.target, outcome.after)
+        except AlarmError:
+            if entry.get("task") == TILT_TASK:
+                self._unaligned_tilt = (offset.target, tilt_deg(outcome.after))
+            raise
+        if entry.get("task") == TILT_TASK:
+            self._unaligned_tilt = None
+        _before, after = unit.put_offset(offset.target, outcome.after, source="measure", detail=outcome.detail)
+        entry["correction"] = outcome.answer.get("correction")
+        return outcome, (offset.target, after)
+
+    def _store_records(self, unit, entry: dict, source: str, detail: dict, probe_update, tool_update,
+                       tool_probe_update) -> dict | None:
+        """The probe record, the tool data and the tool probe record stored in ``unit``; the stored tool."""
+        stored_tool = None
+        if probe_update is not None:
+            record = self._calibrated(unit, "workpiece", probe_update[0], probe_update[1], entry)
+            unit.put_probe(probe_update[0], record, source=source, detail=detail)
+        if tool_update is not None:
+            stored_tool = unit.put_tool(tool_update[0], tool_update[1], source=source, detail=detail)
+        if tool_probe_update is not None:
+            record = self._calibrated(unit, "tool", tool_probe_update[0], tool_probe_update[1], entry)
+            unit.put_tool_probe(tool_probe_update[0], record, source=source, detail=detail)
+        return stored_tool
+
+    def _write_nc(self, generation: int, lines: dict | None, stored_offset, stored_tool: dict | None, *,
+                  records: bool) -> None:
+        """The NC is given what was stored: kinematic data, the WO, the tool."""
         if lines is not None:                  # the NC holds what the audit says
             machine = self._ms.machine
             assert isinstance(machine, KinematicData), "kinematic_facts found the lines on this machine"
             machine.write_kinematic_data(lines)
-        if stored_offset is not None and not (probe_update or tool_update or tool_probe_update):
+        if stored_offset is not None and not records:
             self._written(generation, *stored_offset)
         if stored_offset is not None:          # the NC holds what was stored
             self._ms.write_offset(*stored_offset)
         if stored_tool is not None:
             self._ms.write_tool(stored_tool["t"], stored_tool)
             self._ms.refresh_tool_offset()
-        return log_id, outcome
 
     def _calibrated(self, unit, probe: str, n: int, record: dict, entry: dict) -> dict:
         """A calibration written: a new calibration id (its probe_events row), valid again, the

@@ -65,38 +65,45 @@ def lathe_correction_rows(correction: dict) -> list[dict]:
     tool probe faces (_TP), the probe record (_WP trigger values, diameter, position deviation)
     or a zero offset (its translations)."""
     before, after = correction.get("before") or {}, correction.get("after") or {}
-    rows: list[dict] = []
-
-    def add(label: str, field: str, old, new) -> None:
-        if new is None:
-            return
-        old = 0.0 if old is None else float(old)
-        rows.append({"label": label, "field": field, "before": fmt_result("length", old),
-                     "after": fmt_result("length", float(new)), "changed": abs(float(new) - old) > 1e-9})
-
     if "trans" in after:
-        for axis, new in (after.get("trans") or {}).items():
-            add(_("Offset %(axis)s") % {"axis": axis}, f"trans.{axis}", (before.get("trans") or {}).get(axis), new)
-        return rows
+        return [row for axis, new in (after.get("trans") or {}).items()
+                for row in _row(_("Offset %(axis)s") % {"axis": axis}, f"trans.{axis}",
+                                (before.get("trans") or {}).get(axis), new)]
     if "l1" in after:
-        for key, label in LATHE_TOOL_FIELDS:
-            add(label, key, before.get(key), after.get(key))
-        for key, label in LATHE_TOOL_FIELDS:
-            add(_("Wear %(name)s") % {"name": label}, f"wear.{key}", (before.get("wear") or {}).get(key), (after.get("wear") or {}).get(key))
-        return rows
+        return _tool_rows(before, after)
     if "trigger" in after:
-        for key, new in (after.get("trigger") or {}).items():
-            add(_("Trigger %(direction)s") % {"direction": key}, f"trigger.{key}", (before.get("trigger") or {}).get(key), new)
-        add(_("Effective diameter"), "effective_diameter", before.get("effective_diameter"),
-            after.get("effective_diameter"))
-        for axis, new in (after.get("position_deviation") or {}).items():
-            add(_("Position deviation %(axis)s") % {"axis": axis}, f"position_deviation.{axis}",
-                (before.get("position_deviation") or {}).get(axis), new)
-        return rows
-    for key, new in after.items():                       # _TP / _TPW faces
-        if isinstance(new, int | float):
-            add(_("Face %(direction)s") % {"direction": key}, key, before.get(key), new)
-    return rows
+        return _probe_rows(before, after)
+    return [row for key, new in after.items() if isinstance(new, int | float)     # _TP / _TPW faces
+            for row in _row(_("Face %(direction)s") % {"direction": key}, key, before.get(key), new)]
+
+
+def _row(label: str, field: str, old, new) -> list[dict]:
+    """The row of one value as it was and is (none when nothing was written)."""
+    if new is None:
+        return []
+    old = 0.0 if old is None else float(old)
+    return [{"label": label, "field": field, "before": fmt_result("length", old),
+             "after": fmt_result("length", float(new)), "changed": abs(float(new) - old) > 1e-9}]
+
+
+def _tool_rows(before: dict, after: dict) -> list[dict]:
+    rows = [row for key, label in LATHE_TOOL_FIELDS for row in _row(label, key, before.get(key), after.get(key))]
+    old_wear, new_wear = before.get("wear") or {}, after.get("wear") or {}
+    return rows + [row for key, label in LATHE_TOOL_FIELDS
+                   for row in _row(_("Wear %(name)s") % {"name": label}, f"wear.{key}", old_wear.get(key),
+                                   new_wear.get(key))]
+
+
+def _probe_rows(before: dict, after: dict) -> list[dict]:
+    rows = [row for key, new in (after.get("trigger") or {}).items()
+            for row in _row(_("Trigger %(direction)s") % {"direction": key}, f"trigger.{key}",
+                            (before.get("trigger") or {}).get(key), new)]
+    rows += _row(_("Effective diameter"), "effective_diameter", before.get("effective_diameter"),
+                 after.get("effective_diameter"))
+    old_deviation = before.get("position_deviation") or {}
+    return rows + [row for axis, new in (after.get("position_deviation") or {}).items()
+                   for row in _row(_("Position deviation %(axis)s") % {"axis": axis}, f"position_deviation.{axis}",
+                                   old_deviation.get(axis), new)]
 
 
 def lathe_tool_info(env) -> dict | None:

@@ -77,33 +77,44 @@ def form_data(task: TaskSpec, fields: list[FieldSpec], form: dict | None, gud=No
         text = values.get(spec.name, "")
         if spec.name == "target":
             target = text or None
-            continue
-        if spec.group == "tool":          # the tool offset's fields (design.md §9.3 target object)
-            part, _, key = spec.name.partition(".")
-            if text != "":
-                typed = _typed_value(key, text)
-                if spec.unit == "mm" and isinstance(typed, float) and gud is not None:
-                    typed = _number_value(spec, text, gud, known)
-                (tool if part == "tool_target" else tolerance)[key] = typed
-            continue
-        if spec.kind == "number":
-            if text == "":
-                continue
-            value: object = _number_value(spec, text, gud, known)
-        elif spec.name == "set_p1":
-            value = text == "yes"
+        elif spec.group == "tool":          # the tool offset's fields (design.md §9.3 target object)
+            _tool_field(spec, text, gud, known, tool, tolerance)
         else:
-            value = text
-        if spec.name.startswith("setpoint."):
-            params.setdefault("setpoint", {})[spec.name.split(".", 1)[1]] = value
-        else:
-            params[spec.name] = value
+            _param_field(spec, text, gud, known, params)
     if task.category == Category.TOOL_MEASURING and gud is not None:
         params["compensation"] = gud.tool_offset_mode     # _JM_B[0], shown read-only
     if target == TOOL_TARGET:
         target = tool                                     # the workflow names a missing or bad tool
         params["tolerance"] = tolerance
     return FormData(values=values, params=params, target=target)
+
+
+def _tool_field(spec: FieldSpec, text: str, gud, known: dict, tool: dict, tolerance: dict) -> None:
+    """A typed tool-offset field into the tool target (``tool_target.*``) or its tolerance."""
+    if text == "":
+        return
+    part, _sep, key = spec.name.partition(".")
+    typed = _typed_value(key, text)
+    if spec.unit == "mm" and isinstance(typed, float) and gud is not None:
+        typed = _number_value(spec, text, gud, known)
+    (tool if part == "tool_target" else tolerance)[key] = typed
+
+
+def _param_field(spec: FieldSpec, text: str, gud, known: dict, params: dict) -> None:
+    """A typed field into the API params (``setpoint.X`` into the setpoint object); an empty
+    number is left out."""
+    if spec.kind == "number":
+        if text == "":
+            return
+        value: object = _number_value(spec, text, gud, known)
+    elif spec.name == "set_p1":
+        value = text == "yes"
+    else:
+        value = text
+    if spec.name.startswith("setpoint."):
+        params.setdefault("setpoint", {})[spec.name.split(".", 1)[1]] = value
+    else:
+        params[spec.name] = value
 
 
 def _typed_value(key: str, text: str):

@@ -313,15 +313,7 @@ class WorkflowService:
         """Every refusal of NC Start before anything moves; marks the session running."""
         if session.running or self._env.machine.status().busy:
             raise WorkflowError(409, "busy", "the machine is moving")
-        n = point if point is not None else session.next_point()
-        if n is None:
-            if not session.single_point:
-                raise WorkflowError(409, "all_stored", "all points are stored: press Calculate or invalidate a point")
-            n = 1
-        try:
-            session.slot(n)
-        except KeyError:
-            raise WorkflowError(404, "no_point", f"point P{n} does not exist for {session.task}", "point") from None
+        n = self._start_point(session, point)
         pending = self._env.machine.status().alarms
         if pending:
             raise WorkflowError(409, "alarm", f"{pending[-1].code} {pending[-1].text}: press Reset first")
@@ -332,6 +324,33 @@ class WorkflowService:
                                               "the spindle is not a 3D probe (type 710); change to the probe first")
         self._check_probe_ready(spec, ctx)
         self._check_probe_geometry(spec, ctx)
+        warnings = self._start_warnings(session, spec, ctx)
+        warnings += self._trust_and_guard(session, spec, n, ctx)
+        session.warnings = warnings
+        session.running = True
+        session.last_alarm = None
+        session.notice = None
+        session.progress = {"point": n, "step": 0, "steps": None, "label": ""}
+        return spec, n, ctx
+
+    @staticmethod
+    def _start_point(session: MeasureSession, point: int | None) -> int:
+        """The point NC Start measures: the one asked for, else the next one not stored (P1 again
+        on a single-point task)."""
+        n = point if point is not None else session.next_point()
+        if n is None:
+            if not session.single_point:
+                raise WorkflowError(409, "all_stored", "all points are stored: press Calculate or invalidate a point")
+            n = 1
+        try:
+            session.slot(n)
+        except KeyError:
+            raise WorkflowError(404, "no_point", f"point P{n} does not exist for {session.task}", "point") from None
+        return n
+
+    def _start_warnings(self, session: MeasureSession, spec: TaskSpec, ctx: MeasuringContext) -> list[str]:
+        """The warnings NC Start gives before the guard: the probe's, the unaligned tilt's; a
+        refusal when the override does not match."""
         warnings = self._warnings(spec, ctx)
         tilt = getattr(self._env, "unaligned_tilt_warning", None)
         tilted = tilt() if callable(tilt) and spec.needs_probe and spec.category == Category.WORKPIECE else None
@@ -339,6 +358,10 @@ class WorkflowService:
             warnings.append(tilted)
         if self._refuse_override(ctx):
             raise WorkflowError(409, "override_mismatch", warnings[-1])
+        return warnings
+
+    def _trust_and_guard(self, session: MeasureSession, spec: TaskSpec, n: int, ctx: MeasuringContext) -> list[str]:
+        """The probe-trust findings and the start guard's verdict: refusals, else warnings."""
         # the start guard runs the point's program once; the probe-trust check reads its probing
         # directions from that run (a second run with ideal latches only when it cannot tell)
         # every task: the collisions where the guard has a model, the probe's reach always
@@ -348,15 +371,10 @@ class WorkflowService:
         distrust = probe_trust.findings(spec, session.params, n, ctx, self._env.machine, directions)
         if distrust and ctx.settings.calibration_invalid == "refuse":
             raise WorkflowError(409, distrust[0].code, distrust[0].message)
-        warnings += [f.message for f in distrust]
+        warnings = [f.message for f in distrust]
         if guarded:
             warnings += self._guard_verdict(report, session, spec, n)
-        session.warnings = warnings
-        session.running = True
-        session.last_alarm = None
-        session.notice = None
-        session.progress = {"point": n, "step": 0, "steps": None, "label": ""}
-        return spec, n, ctx
+        return warnings
 
     def _guard_report(self, session: MeasureSession, spec: TaskSpec, n: int, ctx: MeasuringContext
                       ) -> guard.GuardReport | Exception | None:
