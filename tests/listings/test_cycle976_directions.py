@@ -144,6 +144,38 @@ def test_known_centre_four_directions_without_ball_and_skew(client):
     assert record["effective_diameter"] == before_record["effective_diameter"]
 
 
+def test_known_centre_four_directions_at_30_degrees_with_skew_and_ball(client):
+    """_MVAR=110101 _STA1=30 (§5.3.1 "有角度时校准", 4 directions, skew, ball): touches along 30°,
+    210°, 120°, 300° from MP → fields X+, X−, Y+, Y− (closest axis directions); the skew from the
+    two pairs is the true eccentricity, the values ∓(r − δ), d_eff = 2(r − δ)."""
+    m = machine_with(client, {k: DELTA for k in ("X+", "X-", "Y+", "Y-")})
+    m.put_probe(2, skew=[0.0, 0.0])
+    before = snapshot(m, 2)
+    answer = m.mda(program("110101", "_STA1=30"))
+    assert answer["state"] == "done", answer
+    record = m.probe(2)
+    for key in ("X+", "Y+"):
+        assert record["trigger"][key] == pytest.approx(-(R - DELTA), abs=1e-6), key
+    for key in ("X-", "Y-"):
+        assert record["trigger"][key] == pytest.approx(R - DELTA, abs=1e-6), key
+    assert record["skew"] == pytest.approx(list(ECC), abs=1e-9)
+    assert record["effective_diameter"] == pytest.approx(2 * (R - DELTA), abs=1e-6)
+    others_unchanged(m, 2, before)
+    assert m.ovr()[24] == pytest.approx(30.0)
+
+
+def test_beyond_tsa_the_bore_variant_alarms_and_writes_nothing(client):
+    """_MVAR=012101 with _TSA=0.5 and a stored X+ of −3 (the truth is −(r − δ) = −1.996):
+    |Δt| = 1.004 > _TSA → 61303 naming _TSA, record 2 as it was."""
+    m = machine_with(client, {k: DELTA for k in ("X+", "X-", "Y+", "Y-")})
+    m.put_probe(2, trigger={"X+": -3.0, "X-": 3.0})
+    before = m.probe(2)
+    answer = m.mda(program("012101", "_MA=1", tsa=0.5))
+    assert answer["state"] == "alarm" and answer["alarm"]["code"] == 61303, answer
+    assert "_TSA" in answer["alarm"]["message"]
+    assert m.probe(2) == before
+
+
 @pytest.mark.parametrize(("mvar", "extra", "code", "words"), [
     ("012108", "_MA=1", 61307, ("xx0x08", "§5.3.2")),
     ("011101", "_MA=1 _MD=0", 61307, ("xx1x0x", "§5.3")),
