@@ -88,41 +88,55 @@ def _edge(task: str, p: dict, plane: Plane) -> Picture:
         return pic
     pic = Picture(plane)
     horizontal = axis == plane.first
-    dx, dy = _dir(sign, horizontal)
     if task == "edge.distance":                            # a web between the two edges
-        sign2 = str(p.get("direction_p2") or "-")
-        dx2, dy2 = _dir(sign2, horizontal)
-        if horizontal:
-            pic.add('<rect class="help-part" x="95" y="25" width="50" height="100"/>')
-            pic.touch(1, 95 if sign == "+" else 145, 75, dx, dy, axis, sign)
-            pic.touch(2, 145 if sign2 == "-" else 95, 75, dx2, dy2, axis, sign2)
-            pic.p0(120, 75)
-        else:
-            pic.add('<rect class="help-part" x="50" y="50" width="140" height="50"/>')
-            pic.touch(1, 120, 100 if sign == "+" else 50, dx, dy, axis, sign)
-            pic.touch(2, 120, 50 if sign2 == "-" else 100, dx2, dy2, axis, sign2)
-            pic.p0(120, 75)
-        return pic
-    # the face probed: the part lies on the far side of the travel direction
-    if horizontal:
-        face = 100 if sign == "+" else 140
-        pic.add(f'<rect class="help-part" x="{face if sign == "+" else 40}" y="25" width="100" height="100"/>')
-        ys = (55, 100) if task == "edge.align" else (75,)
-        for n, y in enumerate(ys, 1):
-            pic.touch(n, face, y, dx, dy, axis, sign)
-        pic.probe(face - 30 * dx, ys[0], gettext("start"))
-        if task == "edge.set":
-            pic.p0(face, 120, f"{axis}0")
+        _edge_web(pic, axis, sign, str(p.get("direction_p2") or "-"), horizontal)
+    elif horizontal:
+        _edge_face_across(pic, task, axis, sign)
     else:
-        face = 95 if sign == "+" else 55
-        pic.add(f'<rect class="help-part" x="40" y="{face - 70 if sign == "+" else face}" width="160" height="70"/>')
-        xs = (80, 160) if task == "edge.align" else (120,)
-        for n, x in enumerate(xs, 1):
-            pic.touch(n, x, face, dx, dy, axis, sign)
-        pic.probe(xs[0], face - 30 * dy, gettext("start"))
-        if task == "edge.set":
-            pic.p0(190, face, f"{axis}0")
+        _edge_face_along(pic, task, axis, sign)
     return pic
+
+
+def _edge_web(pic: Picture, axis: str, sign: str, sign2: str, horizontal: bool) -> None:
+    dx, dy = _dir(sign, horizontal)
+    dx2, dy2 = _dir(sign2, horizontal)
+    if horizontal:
+        pic.add('<rect class="help-part" x="95" y="25" width="50" height="100"/>')
+        pic.touch(1, 95 if sign == "+" else 145, 75, dx, dy, axis, sign)
+        pic.touch(2, 145 if sign2 == "-" else 95, 75, dx2, dy2, axis, sign2)
+    else:
+        pic.add('<rect class="help-part" x="50" y="50" width="140" height="50"/>')
+        pic.touch(1, 120, 100 if sign == "+" else 50, dx, dy, axis, sign)
+        pic.touch(2, 120, 50 if sign2 == "-" else 100, dx2, dy2, axis, sign2)
+    pic.p0(120, 75)
+
+
+# the face probed: the part lies on the far side of the travel direction
+
+def _edge_face_across(pic: Picture, task: str, axis: str, sign: str) -> None:
+    """An edge probed along the screen's horizontal (the plane's first axis)."""
+    dx, dy = _dir(sign, True)
+    face = 100 if sign == "+" else 140
+    pic.add(f'<rect class="help-part" x="{face if sign == "+" else 40}" y="25" width="100" height="100"/>')
+    ys = (55, 100) if task == "edge.align" else (75,)
+    for n, y in enumerate(ys, 1):
+        pic.touch(n, face, y, dx, dy, axis, sign)
+    pic.probe(face - 30 * dx, ys[0], gettext("start"))
+    if task == "edge.set":
+        pic.p0(face, 120, f"{axis}0")
+
+
+def _edge_face_along(pic: Picture, task: str, axis: str, sign: str) -> None:
+    """An edge probed along the screen's vertical (the plane's second axis)."""
+    dx, dy = _dir(sign, False)
+    face = 95 if sign == "+" else 55
+    pic.add(f'<rect class="help-part" x="40" y="{face - 70 if sign == "+" else face}" width="160" height="70"/>')
+    xs = (80, 160) if task == "edge.align" else (120,)
+    for n, x in enumerate(xs, 1):
+        pic.touch(n, x, face, dx, dy, axis, sign)
+    pic.probe(xs[0], face - 30 * dy, gettext("start"))
+    if task == "edge.set":
+        pic.p0(190, face, f"{axis}0")
 
 
 def _corner(task: str, p: dict, plane: Plane) -> Picture:
