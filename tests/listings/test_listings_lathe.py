@@ -13,10 +13,12 @@ cycle calls are the print's (seed line numbers with each listing in manual_listi
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import pytest
 from manual_listings import (
+    EIN_PUNKT_MESSEN_21272,
     INKR_KALIBRIEREN_19596,
     INKR_MESSEN_20039,
     KALIBRIEREN_IN_NUT_20537,
@@ -25,6 +27,9 @@ from manual_listings import (
     KALIBRIEREN_MTWZ_WKS_17856,
     NV_ERMITTLUNG_1_21058,
     T3_MESSEN_17138,
+    TEIL_1_MESSEN_22159,
+    UMSCHLAGMESSEN_21502,
+    ZWEI_PUNKT_MESSUNG_22051,
 )
 
 SCENARIO = json.loads((Path(__file__).resolve().parents[2] / "app" / "machine" / "lathe_demo_scenario.json")
@@ -39,6 +44,7 @@ BORE = next(p for p in SCENARIO["workpiece"]["profile"] if p["type"] == "bore")
 FACE_Z = SHAFT["z"][1]                                        # the shaft's end face (MCS, chuck face at 0)
 FACES = SCENARIO["tool_probe"]["faces"]                        # the tool probe's true faces (MCS of the tip)
 TOOLS = {t["t"]: t for t in SCENARIO["tools"]}
+ECC = math.hypot(*SCENARIO["workpiece"]["eccentricity"])       # the part's clamping eccentricity (X at SPOS 0)
 NOISE = 1e-6                                                  # noise_sigma 0: the simulator's exact switch
 
 
@@ -90,6 +96,9 @@ class Lathe:
         l1, l2 = row["l1"] + row["wear"]["l1"], row["l2"] + row["wear"]["l2"]
         for axes in ({"Z": 800.0}, {"X": 600.0}, {"Z": z + l2}, {"X": x + l1}):
             self.ok(self.c.post("/api/machine/goto", json={**axes, "coords": "MCS"}))
+
+    def spos(self, angle: float) -> None:
+        self.ok(self.c.post("/api/lathe/spos", json={"angle": angle}))
 
     def g54(self) -> dict[str, float]:
         frame = self.ok(self.c.get("/api/offsets/G54"))
@@ -238,3 +247,110 @@ def test_6_4_3_probe_calibrated_on_the_face(lathe):
     assert ovr[8] == pytest.approx(R_TRUE, abs=NOISE)
     assert ovr[9] == pytest.approx(R_TRUE - PROBE["nominal"]["ball_diameter"] / 2.0, abs=NOISE)
     assert lathe.ok(lathe.c.get("/api/machine"))["wcs"]["X"] == pytest.approx(146.0)   # N50 X146 (Ø)
+
+
+# --- CYCLE974 and CYCLE994: the part (§6.5, §6.6, §6.7) -------------------------------------------------
+
+def one_point_diameter(diameter: float, outside: bool) -> float:
+    """What one point along X measures at SPOS 90 (the eccentricity then lies across X): the ball
+    (true radius) touches the cylinder off its crest; the calibrated trigger is a flat wall's."""
+    big_r = diameter / 2.0
+    if outside:
+        return 2.0 * (math.sqrt((big_r + R_TRUE) ** 2 - ECC ** 2) - R_TRUE)
+    return 2.0 * (math.sqrt((big_r - R_TRUE) ** 2 - ECC ** 2) + R_TRUE)
+
+
+def band(setval: float, tul: float, tll: float) -> float:
+    """The symmetrised setpoint of a tool offset (manual §2.3.11): _SETVAL + (_TUL + _TLL)/2."""
+    return setval + (tul + tll) / 2.0
+
+
+def test_6_5_3_one_point_outside_and_inside_into_two_tools(lathe):
+    """§6.5.3 %_N_EIN_PUNKT_MESSEN_MPF (lines 21272–21296): DIAMON, _CHBIT[4]=1, CYCLE974 _MVAR=0
+    on the shaft Ø45 (−0/−0.01, _K=2) into T7's L1, then in the bore Ø35 (+0.015/0) into T8's L1.
+    Truth: the shaft's and the bore's diameters seen by one point at SPOS 90 (the operator turns
+    the clamping eccentricity across X: at SPOS 0 it would double into the diameter). Shaft: D =
+    Ø − 44.995 is beyond the band (oversize, 62304) and within _TDIF: the whole D corrects
+    (L1 wear −D/2, X a radius). Bore: D within the mean-value range: no correction, the mean
+    D/_K in MV[14]. Adapted: T9 → T8 (the probe), _TNUM 7/8 → 3/1 (this lathe's turning tools; T7
+    is the calibration tool, T8 the probe), N50 Z60 → Z70 (clear of this part's end face Z60)."""
+    calibrate_in_groove(lathe)
+    lathe.spos(90.0)
+    lathe.run(EIN_PUNKT_MESSEN_21272, replace={"T9 D1": "T8 D1", "_TNUM=7": "_TNUM=3", "_TNUM=8": "_TNUM=1",
+                                               "N50 G0 Z60": "N50 G0 Z70"})
+    shaft_d = one_point_diameter(SHAFT["diameter"], outside=True)
+    bore_d = one_point_diameter(BORE["diameter"], outside=False)
+    d_shaft = shaft_d - band(45.0, 0.0, -0.01)
+    assert lathe.tool(3)["wear"]["l1"] == pytest.approx(-d_shaft / 2.0, abs=NOISE)
+    assert lathe.tool(1)["wear"] == {"length": 0.0, "radius": 0.0, "l1": 0.0, "l2": 0.0}
+    ovr = lathe.var("_OVR")                             # the last call: the bore
+    d_bore = bore_d - band(35.0, 0.015, 0.0)
+    assert ovr[0] == pytest.approx(band(35.0, 0.015, 0.0)) and ovr[4] == pytest.approx(bore_d, abs=NOISE)
+    assert ovr[16] == pytest.approx(d_bore, abs=NOISE)
+    assert ovr[31] == pytest.approx(d_bore / 2.0, abs=NOISE)
+    assert lathe.var("_MV")[14 - 1] == pytest.approx(d_bore / 2.0, abs=NOISE)
+    assert lathe.var("_OVI")[2:4] == [974, 0] and lathe.var("_OVI")[8] == 1
+
+
+def test_6_5_reversal_measurement_cancels_the_eccentricity(lathe):
+    """§6.5 %_N_UMSCHLAGMESSEN_MPF (lines 21502–21516): CYCLE974 _MVAR=1000 _STA1=0: the shaft at
+    SPOS 0 and 180, the mean: the true Ø45.006 whatever the clamping eccentricity; D beyond the
+    band (oversize, 62304) corrects T3's L1 wear by −D/2. Adapted: T9 → T8, _TNUM=7 → 3."""
+    calibrate_in_groove(lathe)
+    lathe.run(UMSCHLAGMESSEN_21502, replace={"T9 D1": "T8 D1", "_TNUM=7": "_TNUM=3"})
+    ovr = lathe.var("_OVR")
+    d = SHAFT["diameter"] - band(45.0, 0.0, -0.01)
+    assert ovr[4] == pytest.approx(SHAFT["diameter"], abs=NOISE)
+    assert ovr[16] == pytest.approx(d, abs=NOISE)
+    assert lathe.tool(3)["wear"]["l1"] == pytest.approx(-d / 2.0, abs=NOISE)
+    ovi = lathe.var("_OVI")
+    assert ovi[2:4] == [974, 1000] and ovi[9] == 62304
+
+
+def test_6_6_two_points_outside_with_zone_and_inside(lathe):
+    """§6.6 %_N_ZWEI_PUNKT_MESSUNG_MPF (lines 22051–22080): CYCLE994 _MVAR=2 on the shaft (over the
+    protection zone _SZA/_SZO to the far side) into T3's L1, then in the bore into T1's: two
+    opposite points cancel the eccentricity: the true diameters. Shaft oversize: L1 wear −D/2;
+    bore within _TZL: no correction. Adapted: T1 → T8 (the probe), _TNUM 8/9 → 3/1, _SZA 55 → 70
+    and N50 Z55 → Z70 (this part's end face is at Z60)."""
+    calibrate_in_groove(lathe)
+    lathe.run(ZWEI_PUNKT_MESSUNG_22051, replace={"T1 D1": "T8 D1", "_TNUM=8": "_TNUM=3", "_TNUM=9": "_TNUM=1",
+                                                 "_SZA=55": "_SZA=70", "N50 G0 Z55": "N50 G0 Z70"})
+    d = SHAFT["diameter"] - band(45.0, 0.0, -0.01)
+    assert lathe.tool(3)["wear"]["l1"] == pytest.approx(-d / 2.0, abs=NOISE)
+    assert lathe.tool(1)["wear"]["l1"] == 0.0
+    ovr = lathe.var("_OVR")
+    assert ovr[4] == pytest.approx(BORE["diameter"], abs=NOISE)
+    assert ovr[16] == pytest.approx(BORE["diameter"] - band(35.0, 0.015, -0.01), abs=NOISE)
+    assert lathe.var("_OVI")[2:4] == [994, 2]
+
+
+def test_6_7_part_1_calibrate_then_four_points(lathe):
+    """§6.7 %_N_TEIL_1_MESSEN_MPF (lines 22159–22211): CYCLE973 in the groove (−Z, then −X), then
+    CYCLE974 at four points of the part into four tool lengths. This lathe's part: P1 the shaft
+    (X, Ø45), P2 the end face (Z60), P3 the bore (X, Ø35), P4 the bore's bottom (Z20); G54 lies
+    0.05 off in Z, so the faces read 0.05 short: L2 wear +0.05 (the tip cut 0.05 too deep: its
+    true L2 is 0.05 longer). Adapted: the positions and setpoints of this part (the printed part
+    is Ø200/Ø150 with faces at Z50/Z100), _TNUM 1..4 → 3, 3, 1, 1 (this lathe's turning tools),
+    N160's move into the bore split in two (out over the face, then down). The probe's X+ trigger
+    comes from §6.4.2 before (the listing calibrates −X only)."""
+    calibrate_in_groove(lathe)
+    lathe.put_g54(z=0.05)
+    lathe.spos(90.0)
+    lathe.run(TEIL_1_MESSEN_22159, replace={
+        "X300 Z150": "X160 Z40", "N80 X220": "N80 X90", "_SETVAL=200": "_SETVAL=45", "_MA=2 _TNUM=1": "_MA=2 _TNUM=3",
+        "N130 X175": "N130 X40", "_SETVAL=50": "_SETVAL=60", "_TUL=0.01 _TNUM=2": "_TUL=0.01 _TNUM=3",
+        "N160 G0 Z180": "N160 G0 X0 Z70\nN165 Z40", "_SETVAL=150": "_SETVAL=35", "_TNUM=3 _KNUM=1  ": "_TNUM=1 _KNUM=1  ",
+        "N190 G0 Z150": "N190 G0 Z30", "N200 X50": "N200 X20", "_SETVAL=100": "_SETVAL=20", "_TNUM=4": "_TNUM=1"})
+    record = lathe.ok(lathe.c.get("/api/probes/1"))
+    assert record["trigger"]["Z-"] == pytest.approx(R_TRUE, abs=NOISE)
+    assert record["trigger"]["X-"] == pytest.approx(R_TRUE - DL1, abs=NOISE)
+    p1 = one_point_diameter(SHAFT["diameter"], outside=True) - band(45.0, 0.0, -0.01)       # oversize
+    p3 = one_point_diameter(BORE["diameter"], outside=False) - band(35.0, 0.005, -0.003)    # in the band
+    t3, t1 = lathe.tool(3)["wear"], lathe.tool(1)["wear"]
+    assert t3["l1"] == pytest.approx(-p1 / 2.0, abs=NOISE)
+    assert t3["l2"] == pytest.approx(0.05, abs=NOISE)
+    assert t1["l1"] == pytest.approx(-p3 / 2.0, abs=NOISE)         # beyond _TZL, within the band: _K=1, all of D
+    assert t1["l2"] == pytest.approx(0.05, abs=NOISE)
+    ovr = lathe.var("_OVR")                                        # P4
+    assert ovr[4] == pytest.approx(20.0 - 0.05, abs=NOISE) and ovr[16] == pytest.approx(-0.05, abs=NOISE)
