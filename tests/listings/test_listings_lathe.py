@@ -354,3 +354,22 @@ def test_6_7_part_1_calibrate_then_four_points(lathe):
     assert t1["l2"] == pytest.approx(0.05, abs=NOISE)
     ovr = lathe.var("_OVR")                                        # P4
     assert ovr[4] == pytest.approx(20.0 - 0.05, abs=NOISE) and ovr[16] == pytest.approx(-0.05, abs=NOISE)
+
+
+# --- DIAMON / DIAMOF and the turret (the words the listings use) --------------------------------------
+
+def test_diamon_diamof_and_the_turret_position_the_tool_tip(lathe):
+    """T turns the turret at once (no M6: "N10 T7 D1" of §6.2.2); the tool offset is L1 on X and
+    L2 on Z; DIAMOF: X a radius; DIAMON: X a diameter, G90 and G91 alike, and $AA_IW[X] reads
+    a diameter. Truth: the turret's MCS = the tip + (L1, L2) of the stored T8 (nominal data)."""
+    l1, l2 = PROBE["nominal"]["l1"], PROBE["nominal"]["l2"]
+    lathe.ok(lathe.c.post("/api/nc/run", json={"mda": "N10 T8 D1 G54 G90 DIAMOF\nN20 G0 Z100\nN30 X50\nN40 M2"}))
+    mcs = lathe.ok(lathe.c.get("/api/machine"))["mcs"]
+    assert lathe.ok(lathe.c.get("/api/machine"))["tool"] == 8
+    assert (mcs["X"], mcs["Z"]) == pytest.approx((50.0 + l1, 100.0 + l2))
+    lathe.ok(lathe.c.post("/api/nc/run", json={"mda": "N10 G91 DIAMON X20\nN20 R1=$AA_IW[X]\nN30 M2"}))
+    assert lathe.ok(lathe.c.get("/api/machine"))["mcs"]["X"] == pytest.approx(60.0 + l1)
+    assert lathe.var("R1") == pytest.approx(120.0)
+    lathe.ok(lathe.c.post("/api/nc/run", json={"mda": "N10 G90 X30 Z90 DIAMOF\nN20 G91 X5\nN30 M2"}))
+    mcs = lathe.ok(lathe.c.get("/api/machine"))["mcs"]
+    assert (mcs["X"], mcs["Z"]) == pytest.approx((35.0 + l1, 90.0 + l2))
