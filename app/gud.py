@@ -11,6 +11,8 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
+from app.access.levels import FUNCTIONS
+
 SETTABLE_WO = re.compile(r"^(G500|G5[4-7]|G5(0[5-9]|[1-9][0-9]))$")
 
 
@@ -27,7 +29,6 @@ AccessLevel = Literal[1, 2, 3, 4, 5, 6, 7]
 
 
 def _level(function: str) -> Any:  # what pydantic's Field returns: the default, as far as mypy knows
-    from app.access.levels import FUNCTIONS
 
     spec = FUNCTIONS[function]
     return _f(spec.default, "level", f"{spec.label}: level needed", ACCESS)

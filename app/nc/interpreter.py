@@ -51,6 +51,7 @@ from .modal import (
     MOTION,
     OFFSET,
     PLANE,
+    PLANE_AXES,
     UNITS,
     ModalState,
     g_group,
@@ -175,7 +176,6 @@ class CycleContext:
     @property
     def plane_axes(self) -> tuple[str, str, str]:
         """(abscissa, ordinate, applicate) of the active plane (measuring-math §0.1)."""
-        from .modal import PLANE_AXES
         return PLANE_AXES[self.modal.plane]
 
     def chain(self) -> FrameChain:

@@ -26,9 +26,12 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+from lark.exceptions import LarkError
+
 from engine import alarms
 from engine.alarms import AlarmDef
 
+from .errors import NcError
 from .modal import AXIS_LETTERS
 
 Value = int | float | bool | str
@@ -371,7 +374,7 @@ class Variables:
 
         try:
             var = parse_reference(reference)
-        except Exception:
+        except (NcError, LarkError, ValueError):     # not NC text, or not one variable
             raise UnknownVariable(f"{reference!r} is not a variable reference") from None
         if not var.indices:
             return var.name, None

@@ -11,11 +11,12 @@ from datetime import UTC, datetime
 from pydantic import BaseModel, ValidationError
 
 from app import checks
-from app.errors import InvalidInput, NotFoundError
+from app.errors import ConflictError, InvalidInput, NotFoundError
 from app.records import LATHE_RECORD_KEYS, MAX_PROBE, ProbeData, ToolProbeData
 from app.workflow import probe_trust
 from db import Database
 
+from .offsets import same_values
 from .settings import SettingsService, raise_invalid
 
 
@@ -101,9 +102,6 @@ class _Records:
 
     def restore(self, entry: dict, force: bool = False) -> dict:
         """Undo of a record change (source "undo")."""
-        from app.errors import ConflictError
-
-        from .offsets import same_values
 
         name = entry["offset"]
         n = int(name[2:])

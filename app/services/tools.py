@@ -12,6 +12,7 @@ from app.workflow import probe_trust
 from db import Database
 
 from .machine_service import MachineService
+from .offsets import same_values
 from .probes import invalidation
 from .settings import raise_invalid
 
@@ -80,8 +81,6 @@ class ToolService:
 
     def restore(self, entry: dict, force: bool = False) -> dict:
         """Undo of a tool change (source "undo"); a creation is undone by deleting the tool."""
-        from .offsets import same_values
-
         t = int(entry["offset"].removeprefix("T"))
         before = entry["before"]
         if before is None and self._machine.machine.status().tool == t:

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 from app.errors import ConflictError
 
+from .kinematics import KinematicsService
+
 # the access function an undo of each kind needs (app/access/levels.py)
 UNDO_FUNCTION = {"offset": "offsets", "tool": "tools", "probe": "probe_data", "tool_probe": "probe_data",
                  "memory": "offsets", "settings": "settings", "kinematics": "settings"}
@@ -26,8 +28,6 @@ def undo(services, entry: dict, force: bool = False) -> dict:
     if kind == "tool_probe":
         return services.tool_probes.restore(entry, force)
     if kind == "kinematics":
-        from .kinematics import KinematicsService
-
         return KinematicsService(services.db, services.machine).restore(entry, force)
     raise ConflictError(f"a change of kind {kind!r} cannot be undone here: write the value again",
                         code="not_undoable")

@@ -14,8 +14,10 @@ from dataclasses import dataclass, field
 
 from fastapi import APIRouter, HTTPException, Request, Response
 
+from app.access.deps import denied, measuring_function
 from app.errors import WorkflowError
 from app.i18n import N_, _
+from app.workflow.tasks import task_spec
 
 from .templating import render_screen, softkey, url_path, vkeys
 
@@ -128,8 +130,6 @@ def softkeys(request: Request, menu: Menu, slugs: tuple[str, ...], back: tuple[s
 
 
 def _leaf_denied(request: Request, task: str) -> str:
-    from app.access.deps import denied, measuring_function
-    from app.workflow.tasks import task_spec
 
     try:
         function = measuring_function(task_spec(task).category, "measure_only")

@@ -12,6 +12,7 @@ from fastapi.responses import RedirectResponse
 from app.access.deps import identity_of
 from app.access.levels import keyswitch_level
 from app.access.middleware import is_local
+from app.access.service import SESSION_COOKIE
 from app.api.access import clear_session_cookie, refuse_at_once, set_session_cookie, sign_in
 from app.errors import HmiError
 
@@ -71,7 +72,6 @@ def _signin_submit(request: Request, target: str, user: str, password: str, pane
 
 @router.post("/signout", name="signout_submit")
 def signout_submit(request: Request):
-    from app.access.service import SESSION_COOKIE
 
     request.app.state.access.sign_out(request.cookies.get(SESSION_COOKIE))
     if request.headers.get("HX-Request") == "true":        # htmx follows a 303 itself: tell it instead

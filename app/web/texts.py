@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import re
 
-from app.i18n import N_, _, language
+from app.i18n import N_, _, format_fixed, language
+from app.web import units
 from engine import alarms as catalogue
 
 PROGRAM_STATES = {"active": N_("active"), "interrupted": N_("interrupted"), "reset": N_("reset")}
@@ -64,8 +65,6 @@ def verdict_text(verdict: str) -> str:
 def increment_text(increment: str, gud) -> str:
     """One INC step of the control panel in the screen's unit: 1 µm = INC 1 in mm, 0.0001 inch in
     inch (Operate: the increment counts in the unit's smallest displayed step)."""
-    from app.web import units
-
     try:
         steps = int(increment)
     except ValueError:
@@ -360,8 +359,6 @@ message(r"password: at least (?P<n>\d+) characters", N_("password: at least %(n)
 
 def result_value(key: str, value) -> str:
     """A value of those tables: 4 decimals with the language's decimal sign; yes/no translated."""
-    from app.i18n import format_fixed
-
     if isinstance(value, bool):
         return _("yes") if value else _("no")
     if isinstance(value, int | float):
