@@ -40,6 +40,7 @@ from .machine_data import machine_data
 from .motion import Motion
 from .probe_signal import ProbeSignals
 from .protocol import ActiveFrame, Alarm, MachineAlarm, MachineBusy, MoveResult, ProbeResult
+from .scenario import Scenario
 
 
 class SimulatedControl:
@@ -94,7 +95,8 @@ class SimulatedControl:
     # --- machine data (MachineData, manual ch. 9) ---------------------------------------------
     def machine_data(self) -> dict[str, Any]:
         """MD number -> value: as commissioned for the measuring cycles, with the scenario's own."""
-        return machine_data(getattr(self._scenario.machine, "machine_data", None))
+        scenario = self._scenario
+        return machine_data(scenario.machine.machine_data if isinstance(scenario, Scenario) else None)
 
     @property
     def axes(self) -> tuple[str, ...]:

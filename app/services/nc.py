@@ -30,6 +30,7 @@ import numpy as np
 
 from app import checks
 from app.errors import ConflictError, HmiError, InvalidInput, ModeError, NotFoundError, TooLarge
+from app.machine.lathe import LatheStatus
 from app.machine.protocol import MachineAlarm, MachineBusy
 from app.nc import Interpreter, NcRuntimeError, NcStateError, NcSyntaxError, VariableError, Variables
 from app.nc.cycles import measuring_cycles
@@ -168,7 +169,8 @@ class MachineRuntime:
 
     def lathe_lengths(self) -> tuple[float, float]:
         """The NC's effective (L1, L2) of the tool in the turret (geometry + wear)."""
-        l1, l2 = getattr(self._machine.status(), "tool_lengths", (0.0, 0.0))
+        status = self._machine.status()
+        l1, l2 = status.tool_lengths if isinstance(status, LatheStatus) else (0.0, 0.0)
         return float(l1), float(l2)
 
     def tool_state(self) -> tuple[int | None, int]:
