@@ -27,6 +27,7 @@ from manual_listings import (
     KALIBRIEREN_MTWZ_WKS_17856,
     NV_ERMITTLUNG_1_21058,
     T3_MESSEN_17138,
+    T3_MESSEN_FR_18606,
     TEIL_1_MESSEN_22159,
     UMSCHLAGMESSEN_21502,
     ZWEI_PUNKT_MESSUNG_22051,
@@ -373,3 +374,18 @@ def test_diamon_diamof_and_the_turret_position_the_tool_tip(lathe):
     lathe.ok(lathe.c.post("/api/nc/run", json={"mda": "N10 G90 X30 Z90 DIAMOF\nN20 G91 X5\nN30 M2"}))
     mcs = lathe.ok(lathe.c.get("/api/machine"))["mcs"]
     assert (mcs["X"], mcs["Z"]) == pytest.approx((35.0 + l1, 90.0 + l2))
+
+
+def test_6_3_3_a_mill_on_the_lathe_is_refused_with_a_turning_tool(lathe):
+    """§6.3.3 %_N_T3_MESSEN_FR_MPF (lines 18606–18626): CYCLE982 _MVAR=12001 measures a milling
+    cutter (L2 and R, radial, _STA1=15). The simulated lathe holds turning tools only (scenario
+    tools type 5xy), so T3 here is a turning tool: the cycle refuses the mill digits with 61307
+    at the call, nothing is written; the listing's words themselves all run (no syntax error).
+    Adapted: the start position (Z285 X450 → Z240 X420, above the tool probe)."""
+    before = lathe.tool(3)
+    text = T3_MESSEN_FR_18606.text.replace("Z285 X450", "Z240 X420")
+    answer = lathe.ok(lathe.c.post("/api/nc/run", json={"mda": text}))
+    assert answer["state"] == "alarm" and answer["block"]["number"] == 140
+    assert answer["alarm"]["code"] == 61307 and "mill digits with a turning tool" in answer["alarm"]["message"]
+    assert lathe.tool(3) == before
+    assert lathe.var("_OVI")[9] == 61307
