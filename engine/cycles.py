@@ -162,89 +162,132 @@ def sphere_program(params: dict[str, Any], start: FloatArray, ctx: PlanContext, 
     rn = float(params["diameter"]) / 2.0
     if not rn > 0.0:
         raise MeasuringError(alarms.SPHERE_DIAMETER, f"sphere diameter {2 * rn:g}: _SETVAL must be > 0")
-    rho = effective_radius(ctx.probe)
-    fa = ctx.measuring_path
-    reach = rn + rho + fa
-    a_hat, o_hat, p_hat = plane.unit(plane.first), plane.unit(plane.second), plane.infeed_unit
+    reach = rn + effective_radius(ctx.probe) + ctx.measuring_path
     start_height = float(plane.to_aop(m.start + m.ball_offset)[2])
     q = np.asarray(params["center"], dtype=float)
     runs = 2 if params.get("repeat") else 1             # >= 1: the loop sets point
     for run in range(runs):
-        qa, qo, qp = (float(v) for v in plane.to_aop(q))
-        safe = max(start_height, qp + reach)
-
-        def at(a: float, o: float, p: float) -> FloatArray:
-            return plane.to_xyz(np.array([a, o, p]))
-
-        def go(target: FloatArray, what: str, safe: float = safe) -> Program[None]:
-            """Up to the safe height, across, down to ``target`` (ball centre).
-
-            The crossing is at the safe height also when the probe already stands there (a start
-            at or above the safe height): a diagonal from there down to an equator point can cut
-            through the sphere (issue 24)."""
-            here = plane.to_aop(m.pos + m.ball_offset)
-            ta, to, tp = plane.to_aop(target)
-            if not (abs(here[0] - ta) < 1e-9 and abs(here[1] - to) < 1e-9):
-                if here[2] < safe - 1e-9:
-                    yield from m.to_ball(at(here[0], here[1], safe), f"{what} up")
-                yield from m.to_ball(at(ta, to, max(safe, float(here[2]))), f"{what} across")
-            yield from m.to_ball(target, what)
-
-        def touch(origin: FloatArray, d: FloatArray, what: str) -> Program[Touch]:
-            yield from go(origin, f"{what} start")
-            latch = yield from m.probe(d, 2.0 * fa, what, expected=fa)
-            yield from m.to_ball(origin, f"{what} retract")
-            return make_touch(latch.rec, d, ctx.probe, plane, skew_wcs=ctx.skew_wcs, spindle_angle=ctx.spindle_angle, wcs2bcs=ctx.wcs2bcs, latched_mcs=latch.latched_mcs)
-
+        qp = float(plane.to_aop(q)[2])
+        moves = _SphereMoves(m, ctx, safe=max(start_height, qp + reach))
         tag = f"{label} run {run + 1}" if runs > 1 else label
-        touches: list[Touch] = []
-        if params.get("angle"):
-            n = int(params.get("points", 3))
-            if n not in (3, 4):
-                raise MeasuringError(alarms.WRONG_VARIANT, f"CYCLE997 at an angle measures 3 or 4 points, not {n}")
-            sta1, inca = float(params.get("start_angle", 0.0)), float(params.get("increment", 120.0))
-            centre = at(qa, qo, qp)
-            for i in range(n):
-                theta = sta1 + i * inca
-                u = _u(plane, theta)
-                if i:
-                    yield from _arc(m, centre, reach, plane, theta - inca, theta, params.get("circle_feed"),
-                                    f"{tag} P{i + 1}")
-                t = yield from touch(centre + reach * u, -u, f"{tag} P{i + 1}")
-                touches.append(t)
-            ca, co = (float(v) for v in fit_circle(np.array([plane.to_aop(t.ball_centre)[:2]
-                                                             for t in touches])).center)
-            kind, k = "angle", n
-        else:
-            touches.append((yield from touch(at(qa - reach, qo, qp), a_hat, f"{tag} P1 +{plane.first}")))
-            touches.append((yield from touch(at(qa + reach, qo, qp), -a_hat, f"{tag} P2 -{plane.first}")))
-            ca = float(0.5 * (touches[0].surface + touches[1].surface) @ a_hat)
-            touches.append((yield from touch(at(ca, qo - reach, qp), o_hat, f"{tag} P3 +{plane.second}")))
-            touches.append((yield from touch(at(ca, qo + reach, qp), -o_hat, f"{tag} P4 -{plane.second}")))
-            co = float(0.5 * (touches[2].surface + touches[3].surface) @ o_hat)
-            kind, k = "paraxial", 4
-        top = yield from touch(at(ca, co, qp + reach), -p_hat, f"{tag} P{k + 1} -{plane.infeed}")
-        touches.append(top)
-        if params.get("determine"):
-            # P6 through the centre as known so far (p = z_top − R); "refine" [I]: when the found
-            # R moves that height by more than 1e-6 mm, once more at the corrected height (the
-            # chord error (Δp)²/2(R+ρ) of the first touch then drops below 1e-10 mm)
-            z_top = float(plane.to_aop(top.surface)[2])
-            height, a_found = z_top - rn, ca
-            for attempt in range(3 if params.get("refine", True) else 1):
-                t6 = yield from touch(at(a_found - reach, co, height), a_hat, f"{tag} P{k + 2 + attempt} diameter")
-                touches.append(t6)
-                new_height = z_top - (a_found - float(t6.surface @ a_hat))
-                if abs(new_height - height) <= 1e-6:
-                    break
-                height = new_height
-        point = SpherePoint(kind, 2.0 * rn, bool(params.get("determine")), tuple(touches), np.zeros(3), 0.0, k)
-        centre, diameter = evaluate_sphere(point, plane)
-        point = SpherePoint(kind, 2.0 * rn, point.determine, point.touches, centre, diameter, k)
-        q = centre
-        ca, co, _cp = plane.to_aop(centre)
-        yield from go(at(ca, co, safe), f"{tag} end")
+        point = yield from _sphere_run(moves, params, q, rn, reach, tag)
+        q = point.center
+        ca, co, _cp = plane.to_aop(point.center)
+        yield from moves.go(moves.at(ca, co, moves.safe), f"{tag} end")
     return point
+
+
+class _SphereMoves:
+    """The probe's moves around one sphere: across at the safe height, touches along a direction."""
+
+    def __init__(self, m: Motion, ctx: PlanContext, *, safe: float) -> None:
+        self.m, self.ctx, self.plane, self.safe = m, ctx, ctx.plane, safe
+
+    def at(self, a: float, o: float, p: float) -> FloatArray:
+        return self.plane.to_xyz(np.array([a, o, p]))
+
+    def go(self, target: FloatArray, what: str) -> Program[None]:
+        """Up to the safe height, across, down to ``target`` (ball centre).
+
+        The crossing is at the safe height also when the probe already stands there (a start
+        at or above the safe height): a diagonal from there down to an equator point can cut
+        through the sphere (issue 24)."""
+        m, plane, safe = self.m, self.plane, self.safe
+        here = plane.to_aop(m.pos + m.ball_offset)
+        ta, to, tp = plane.to_aop(target)
+        if not (abs(here[0] - ta) < 1e-9 and abs(here[1] - to) < 1e-9):
+            if here[2] < safe - 1e-9:
+                yield from m.to_ball(self.at(here[0], here[1], safe), f"{what} up")
+            yield from m.to_ball(self.at(ta, to, max(safe, float(here[2]))), f"{what} across")
+        yield from m.to_ball(target, what)
+
+    def touch(self, origin: FloatArray, d: FloatArray, what: str) -> Program[Touch]:
+        m, ctx, fa = self.m, self.ctx, self.ctx.measuring_path
+        yield from self.go(origin, f"{what} start")
+        latch = yield from m.probe(d, 2.0 * fa, what, expected=fa)
+        yield from m.to_ball(origin, f"{what} retract")
+        return make_touch(latch.rec, d, ctx.probe, self.plane, skew_wcs=ctx.skew_wcs, spindle_angle=ctx.spindle_angle,
+                          wcs2bcs=ctx.wcs2bcs, latched_mcs=latch.latched_mcs)
+
+
+def _sphere_run(moves: _SphereMoves, params: dict[str, Any], q: FloatArray, rn: float, reach: float,
+                tag: str) -> Program[SpherePoint]:
+    """One run around the sphere nominally at ``q``: the equator touches, the top, the diameter."""
+    plane = moves.plane
+    qa, qo, qp = (float(v) for v in plane.to_aop(q))
+    if params.get("angle"):
+        touches, ca, co, k = yield from _sphere_equator_at_angle(moves, params, (qa, qo, qp), reach, tag)
+        kind = "angle"
+    else:
+        touches, ca, co, k = yield from _sphere_equator_paraxial(moves, (qa, qo, qp), reach, tag)
+        kind = "paraxial"
+    top = yield from moves.touch(moves.at(ca, co, qp + reach), -plane.infeed_unit, f"{tag} P{k + 1} -{plane.infeed}")
+    touches.append(top)
+    if params.get("determine"):
+        touches += yield from _sphere_diameter_touches(moves, params, top, (ca, co), rn, reach, tag, k + 2)
+    point = SpherePoint(kind, 2.0 * rn, bool(params.get("determine")), tuple(touches), np.zeros(3), 0.0, k)
+    centre, diameter = evaluate_sphere(point, plane)
+    return SpherePoint(kind, 2.0 * rn, point.determine, point.touches, centre, diameter, k)
+
+
+def _sphere_equator_at_angle(moves: _SphereMoves, params: dict[str, Any], q: tuple[float, float, float],
+                             reach: float, tag: str) -> Program[tuple[list[Touch], float, float, int]]:
+    """3 or 4 touches on the equator from ``start_angle`` by ``increment``, on arcs between them:
+    (touches, the circle's centre a, o, the number of touches)."""
+    plane = moves.plane
+    n = int(params.get("points", 3))
+    if n not in (3, 4):
+        raise MeasuringError(alarms.WRONG_VARIANT, f"CYCLE997 at an angle measures 3 or 4 points, not {n}")
+    sta1, inca = float(params.get("start_angle", 0.0)), float(params.get("increment", 120.0))
+    centre = moves.at(*q)
+    touches: list[Touch] = []
+    for i in range(n):
+        theta = sta1 + i * inca
+        u = _u(plane, theta)
+        if i:
+            yield from _arc(moves.m, centre, reach, plane, theta - inca, theta, params.get("circle_feed"),
+                            f"{tag} P{i + 1}")
+        touches.append((yield from moves.touch(centre + reach * u, -u, f"{tag} P{i + 1}")))
+    ca, co = (float(v) for v in fit_circle(np.array([plane.to_aop(t.ball_centre)[:2] for t in touches])).center)
+    return touches, ca, co, n
+
+
+def _sphere_equator_paraxial(moves: _SphereMoves, q: tuple[float, float, float], reach: float,
+                             tag: str) -> Program[tuple[list[Touch], float, float, int]]:
+    """Two touches along the abscissa, two along the ordinate through their middle: (touches,
+    the centre a, o, 4)."""
+    plane = moves.plane
+    qa, qo, qp = q
+    a_hat, o_hat = plane.unit(plane.first), plane.unit(plane.second)
+    at, touch = moves.at, moves.touch
+    touches = [(yield from touch(at(qa - reach, qo, qp), a_hat, f"{tag} P1 +{plane.first}")),
+               (yield from touch(at(qa + reach, qo, qp), -a_hat, f"{tag} P2 -{plane.first}"))]
+    ca = float(0.5 * (touches[0].surface + touches[1].surface) @ a_hat)
+    touches.append((yield from touch(at(ca, qo - reach, qp), o_hat, f"{tag} P3 +{plane.second}")))
+    touches.append((yield from touch(at(ca, qo + reach, qp), -o_hat, f"{tag} P4 -{plane.second}")))
+    co = float(0.5 * (touches[2].surface + touches[3].surface) @ o_hat)
+    return touches, ca, co, 4
+
+
+def _sphere_diameter_touches(moves: _SphereMoves, params: dict[str, Any], top: Touch, centre: tuple[float, float],
+                             rn: float, reach: float, tag: str, first: int) -> Program[list[Touch]]:
+    """P6 through the centre as known so far (p = z_top − R); "refine" [I]: when the found R moves
+    that height by more than 1e-6 mm, once more at the corrected height (the chord error
+    (Δp)²/2(R+ρ) of the first touch then drops below 1e-10 mm). ``first``: the first one's number."""
+    plane = moves.plane
+    a_hat = plane.unit(plane.first)
+    z_top = float(plane.to_aop(top.surface)[2])
+    a_found, co = centre
+    height = z_top - rn
+    touches: list[Touch] = []
+    for attempt in range(3 if params.get("refine", True) else 1):
+        t6 = yield from moves.touch(moves.at(a_found - reach, co, height), a_hat, f"{tag} P{first + attempt} diameter")
+        touches.append(t6)
+        new_height = z_top - (a_found - float(t6.surface @ a_hat))
+        if abs(new_height - height) <= 1e-6:
+            break
+        height = new_height
+    return touches
 
 
 # --- CYCLE119 (measuring-math §13.3) ----------------------------------------------------------------

@@ -398,93 +398,120 @@ def r_parameters(count: int = 100) -> VarDef:
     return VarDef("R", "REAL", (count,), 0.0, scope="R", description="R parameters")
 
 
+GUD5, GUD6 = "GUD5", "GUD6"
+
+
+def _gud_real(name, default=0.0, shape=(), text="", scope=GUD5) -> VarDef:
+    return VarDef(name, "REAL", shape, default, scope=scope, description=text)
+
+
+def _gud_int(name, default=0, shape=(), text="", scope=GUD5) -> VarDef:
+    return VarDef(name, "INT", shape, default, scope=scope, description=text)
+
+
+def _gud_bool(name, default=0, shape=(), text="", scope=GUD6) -> VarDef:
+    return VarDef(name, "BOOL", shape, default, scope=scope, description=text)
+
+
+def _gud_string(name, length, default="", shape=(), text="", scope=GUD5) -> VarDef:
+    return VarDef(name, "STRING", shape, default, length=length, scope=scope, description=text)
+
+
 def measuring_cycle_gud(*, ev_count: int = 20, mv_count: int = 20, probe_records: int = 3,
                         tool_probe_records: int = 3, calibration_records: int = 3) -> list[VarDef]:
     """GUD5/GUD6 of the measuring cycles SW 6.3 (measuring-math §3.2, measuring-math §4; manual §2.2, §9.2.1)."""
-    g5, g6 = "GUD5", "GUD6"
+    return [*_gud_inputs(), *_gud_results(ev_count, mv_count),
+            *_gud_records(ev_count, mv_count, probe_records, tool_probe_records, calibration_records),
+            *_gud_logging()]
 
-    def real(name, default=0.0, shape=(), text="", scope=g5):
-        return VarDef(name, "REAL", shape, default, scope=scope, description=text)
 
-    def integer(name, default=0, shape=(), text="", scope=g5):
-        return VarDef(name, "INT", shape, default, scope=scope, description=text)
+def _gud_inputs() -> list[VarDef]:
+    return [
+        # --- input parameters (measuring-math §4.1) --------------------------------------------------------
+        _gud_int("_MVAR", text="measuring variant"),
+        _gud_int("_MA", text="measuring axis (1 abscissa, 2 ordinate, 3 applicate)"),
+        _gud_int("_MD", text="measuring direction (0 +, 1 -)"),
+        _gud_real("_SETVAL", text="setpoint (active unit system)"),
+        _gud_real("_SETV", shape=(9,), text="additional setpoints"),
+        _gud_real("_ID", text="incremental infeed / offset"),
+        _gud_real("_CPA", text="centre abscissa"),
+        _gud_real("_CPO", text="centre ordinate"),
+        _gud_real("_SZA", text="protection zone abscissa"),
+        _gud_real("_SZO", text="protection zone ordinate"),
+        _gud_real("_STA1", text="start / setpoint angle"),
+        _gud_real("_INCA", text="incremental / second angle"),
+        _gud_int("_RA", text="CYCLE998: 0 rotate the frame, > 0 rotary axis"),
+        _gud_real("_RF", text="feed on circular intermediate paths"),
+        _gud_int("_TNUM", text="tool number for automatic tool offset"),
+        _gud_string("_TNAME", 32, text="tool name"),
+        _gud_int("_KNUM", text="correction target (zero offset or tool offset)"),
+        _gud_int("_DLNUM", text="DL number of setup/sum offset"),
+        _gud_string("_TENV", 32, text="tool environment"),
+        _gud_real("_VMS", text="variable measuring feed (0 = 150/300 mm/min)"),
+        _gud_real("_CORA", text="correction angle for mono probes"),
+        _gud_real("_TZL", 0.001, text="zero offset range"),
+        _gud_real("_TMV", 0.7, text="mean value range"),
+        _gud_real("_TNVL", 1.2, text="triangle distortion limit"),
+        _gud_real("_TUL", 1.0, text="upper tolerance"),
+        _gud_real("_TLL", -1.0, text="lower tolerance"),
+        _gud_real("_TDIF", 1.2, text="dimensional difference check"),
+        _gud_real("_TSA", 2.0, text="safe area"),
+        _gud_real("_FA", 2.0, text="measuring path in mm"),
+        _gud_int("_PRNUM", 1, text="probe number"),
+        _gud_int("_EVNUM", 0, text="empirical / mean value memory"),
+        _gud_int("_CALNUM", 0, text="calibration body number"),
+        _gud_int("_NMSP", 1, text="measurements at the same point"),
+        _gud_int("_K", 1, text="weighting factor of the mean value"),
+        _gud_int("_NPTS", 0, text="touches on a circle, 3..36 (this HMI's extension; 0 = as the manual)"),
+    ]
 
-    def boolean(name, default=0, shape=(), text="", scope=g6):
-        return VarDef(name, "BOOL", shape, default, scope=scope, description=text)
 
-    def string(name, length, default="", shape=(), text="", scope=g5):
-        return VarDef(name, "STRING", shape, default, length=length, scope=scope, description=text)
+def _gud_results(ev_count: int, mv_count: int) -> list[VarDef]:
+    return [
+        # --- results (measuring-math §4.2) ------------------------------------------------------------------
+        _gud_real("_OVR", shape=(32,), text="results, real"),
+        _gud_int("_OVI", shape=(14,), text="results, integer"),
+        # --- empirical and mean values (GUD5, persistent) ------------------------------------
+        _gud_real("_EV", shape=(ev_count,), text="empirical values"),
+        _gud_real("_MV", shape=(mv_count,), text="mean values"),
+    ]
 
+
+def _gud_records(ev_count: int, mv_count: int, probe_records: int, tool_probe_records: int,
+                 calibration_records: int) -> list[VarDef]:
     cbit = [0] * 16
     cbit[3] = cbit[8] = 1
     chbit = [0] * 30
     chbit[1] = chbit[2] = chbit[24] = 1
     return [
-        # --- input parameters (measuring-math §4.1) --------------------------------------------------------
-        integer("_MVAR", text="measuring variant"),
-        integer("_MA", text="measuring axis (1 abscissa, 2 ordinate, 3 applicate)"),
-        integer("_MD", text="measuring direction (0 +, 1 -)"),
-        real("_SETVAL", text="setpoint (active unit system)"),
-        real("_SETV", shape=(9,), text="additional setpoints"),
-        real("_ID", text="incremental infeed / offset"),
-        real("_CPA", text="centre abscissa"),
-        real("_CPO", text="centre ordinate"),
-        real("_SZA", text="protection zone abscissa"),
-        real("_SZO", text="protection zone ordinate"),
-        real("_STA1", text="start / setpoint angle"),
-        real("_INCA", text="incremental / second angle"),
-        integer("_RA", text="CYCLE998: 0 rotate the frame, > 0 rotary axis"),
-        real("_RF", text="feed on circular intermediate paths"),
-        integer("_TNUM", text="tool number for automatic tool offset"),
-        string("_TNAME", 32, text="tool name"),
-        integer("_KNUM", text="correction target (zero offset or tool offset)"),
-        integer("_DLNUM", text="DL number of setup/sum offset"),
-        string("_TENV", 32, text="tool environment"),
-        real("_VMS", text="variable measuring feed (0 = 150/300 mm/min)"),
-        real("_CORA", text="correction angle for mono probes"),
-        real("_TZL", 0.001, text="zero offset range"),
-        real("_TMV", 0.7, text="mean value range"),
-        real("_TNVL", 1.2, text="triangle distortion limit"),
-        real("_TUL", 1.0, text="upper tolerance"),
-        real("_TLL", -1.0, text="lower tolerance"),
-        real("_TDIF", 1.2, text="dimensional difference check"),
-        real("_TSA", 2.0, text="safe area"),
-        real("_FA", 2.0, text="measuring path in mm"),
-        integer("_PRNUM", 1, text="probe number"),
-        integer("_EVNUM", 0, text="empirical / mean value memory"),
-        integer("_CALNUM", 0, text="calibration body number"),
-        integer("_NMSP", 1, text="measurements at the same point"),
-        integer("_K", 1, text="weighting factor of the mean value"),
-        integer("_NPTS", 0, text="touches on a circle, 3..36 (this HMI's extension; 0 = as the manual)"),
-        # --- results (measuring-math §4.2) ------------------------------------------------------------------
-        real("_OVR", shape=(32,), text="results, real"),
-        integer("_OVI", shape=(14,), text="results, integer"),
-        # --- empirical and mean values (GUD5, persistent) ------------------------------------
-        real("_EV", shape=(ev_count,), text="empirical values"),
-        real("_MV", shape=(mv_count,), text="mean values"),
         # --- GUD6: data records, bits, feeds ---------------------------------------------------
-        integer("_CVAL", (tool_probe_records, probe_records, calibration_records, tool_probe_records),
-                (4,), "number of data records", scope=g6),
-        real("_TP", (0, 0, 0, 0, 0, 0, 0, 133, 0, 2), (tool_probe_records, 10),
-             "tool probe, machine-related", scope=g6),
-        real("_TPW", (0, 0, 0, 0, 0, 0, 0, 133, 0, 2), (tool_probe_records, 10),
-             "tool probe, workpiece-related", scope=g6),
-        real("_WP", (6, 3, -3, 3, -3, 3, -3, 0, 0, 0, 0), (probe_records, 11), "workpiece probe", scope=g6),
-        real("_KB", 0.0, (calibration_records, 7), "calibration bodies", scope=g6),
-        real("_CM", (100, 1000, 1, 0.005, 20, 4, 10, 0), (8,), "tool measuring, rotating spindle", scope=g6),
-        real("_MFS", 0.0, (6,), "speeds and feeds, rotating spindle", scope=g6),
-        boolean("_CBIT", tuple(cbit), (16,), "central bits"),
-        boolean("_CHBIT", tuple(chbit), (30,), "channel bits"),
-        real("_SPEED", (50, 1000, 1000, 900), (4,), "traversing velocities", scope=g6),
-        integer("_EVMVNUM", (ev_count, mv_count), (2,), "number of EV / MV memories", scope=g6),
+        _gud_int("_CVAL", (tool_probe_records, probe_records, calibration_records, tool_probe_records),
+                (4,), "number of data records", scope=GUD6),
+        _gud_real("_TP", (0, 0, 0, 0, 0, 0, 0, 133, 0, 2), (tool_probe_records, 10),
+             "tool probe, machine-related", scope=GUD6),
+        _gud_real("_TPW", (0, 0, 0, 0, 0, 0, 0, 133, 0, 2), (tool_probe_records, 10),
+             "tool probe, workpiece-related", scope=GUD6),
+        _gud_real("_WP", (6, 3, -3, 3, -3, 3, -3, 0, 0, 0, 0), (probe_records, 11), "workpiece probe", scope=GUD6),
+        _gud_real("_KB", 0.0, (calibration_records, 7), "calibration bodies", scope=GUD6),
+        _gud_real("_CM", (100, 1000, 1, 0.005, 20, 4, 10, 0), (8,), "tool measuring, rotating spindle", scope=GUD6),
+        _gud_real("_MFS", 0.0, (6,), "speeds and feeds, rotating spindle", scope=GUD6),
+        _gud_bool("_CBIT", tuple(cbit), (16,), "central bits"),
+        _gud_bool("_CHBIT", tuple(chbit), (30,), "channel bits"),
+        _gud_real("_SPEED", (50, 1000, 1000, 900), (4,), "traversing velocities", scope=GUD6),
+        _gud_int("_EVMVNUM", (ev_count, mv_count), (2,), "number of EV / MV memories", scope=GUD6),
+    ]
+
+
+def _gud_logging() -> list[VarDef]:
+    return [
         # --- logging (measuring-math §15) ---------------------------------------------------------------------
-        string("_PROTNAME", 32, shape=(2,), text="log: program and file name", scope=g6),
-        string("_HEADLINE", 80, shape=(10,), text="log: header lines", scope=g6),
-        integer("_PROTFORM", (60, 80, 1, 3, 1, 12), (6,), "log: format", scope=g6),
-        string("_PROTSYM", 1, (";", "#"), (2,), "log: separators", scope=g6),
-        string("_PROTVAL", 100, shape=(13,), text="log: header lines and values", scope=g6),
-        integer("_DIGIT", 3, text="log: decimal places", scope=g6),
-        string("_TXT", 12, shape=(100,), text="log: formatted texts", scope=g6),
+        _gud_string("_PROTNAME", 32, shape=(2,), text="log: program and file name", scope=GUD6),
+        _gud_string("_HEADLINE", 80, shape=(10,), text="log: header lines", scope=GUD6),
+        _gud_int("_PROTFORM", (60, 80, 1, 3, 1, 12), (6,), "log: format", scope=GUD6),
+        _gud_string("_PROTSYM", 1, (";", "#"), (2,), "log: separators", scope=GUD6),
+        _gud_string("_PROTVAL", 100, shape=(13,), text="log: header lines and values", scope=GUD6),
+        _gud_int("_DIGIT", 3, text="log: decimal places", scope=GUD6),
+        _gud_string("_TXT", 12, shape=(100,), text="log: formatted texts", scope=GUD6),
     ]
 
 
