@@ -96,7 +96,8 @@ class Frame:
     # --- construction -------------------------------------------------------------------
     @classmethod
     def identity(cls) -> Frame:
-        return cls()
+        # one shared value (frames are immutable): compositions with it are found in _composed
+        return _IDENTITY if cls is Frame else cls()
 
     @classmethod
     def from_matrix(cls, rotation: npt.ArrayLike, translation: npt.ArrayLike,
@@ -178,6 +179,9 @@ class Frame:
 
         Rotary offsets add up. The result carries all translation in ``coarse``.
         """
+        return _composed(self, inner)
+
+    def _compose(self, inner: Frame) -> Frame:
         rotation = self.rotation @ inner.rotation
         translation = self.rotation @ inner.translation + self.translation
         rotary = dict(self.rotary)
@@ -210,6 +214,16 @@ class Frame:
         return _frame_of(coarse, tuple(float(fine.get(a, 0.0)) for a in GEOMETRY_AXES),
                          tuple(float(rot.get(a, 0.0)) for a in GEOMETRY_AXES),
                          tuple(sorted((str(k), float(v)) for k, v in trans.items())))
+
+
+_IDENTITY = Frame()
+
+
+@functools.lru_cache(maxsize=1024)
+def _composed(outer: Frame, inner: Frame) -> Frame:
+    # by identity (frames are immutable values, eq=False): every measuring context composes the
+    # same stored frames (the chain BASIC_REF ∘ BASIC_0 ∘ … ∘ G54) again; the same result, once
+    return outer._compose(inner)
 
 
 @functools.lru_cache(maxsize=512)

@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Annotated, Any
 
 from fastapi import APIRouter, Body, Path, Query, Request
+from fastapi.encoders import jsonable_encoder
 from fastapi.responses import JSONResponse
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictInt
 
@@ -96,7 +97,17 @@ def nc_start(request: Request, session_id: SessionId, workflow: WorkflowDep,
     session = workflow.get(session_id)
     require_measurement(request, session.task, session.target)
     answer = workflow.start(session_id, body.point, wait=body.wait)
-    return answer if body.wait else JSONResponse(answer, status_code=202)
+    return json_answer(answer, 200 if body.wait else 202)
+
+
+def json_answer(answer: dict, status_code: int = 200) -> JSONResponse:
+    """``answer`` as FastAPI would send it (``jsonable_encoder`` then ``JSONResponse``), rendered in
+    one ``json.dumps`` when it holds only JSON's own types (the workflow's answers do: the same
+    bytes without walking the answer twice, issue 30); anything else goes through the encoder."""
+    try:
+        return JSONResponse(answer, status_code=status_code)
+    except TypeError:               # a value json.dumps does not know (a model, a date): FastAPI's way
+        return JSONResponse(jsonable_encoder(answer), status_code=status_code)
 
 
 @router.post("/{session_id}/points/{n}/invalidate", name="api_measure_invalidate", dependencies=[needs("measure")])
