@@ -117,15 +117,6 @@ class Solid:
         (cx, cy, cz), _, _, bound = self._plain
         return math.sqrt((x - cx) ** 2 + (y - cy) ** 2 + (z - cz) ** 2) - bound
 
-    def segment_bound(self, a: tuple[float, float, float], b: tuple[float, float, float]) -> float:
-        """|segment a→b − centre| − bound: ``lower_bound``'s least value along the segment."""
-        (cx, cy, cz), _, _, bound = self._plain
-        ex, ey, ez = b[0] - a[0], b[1] - a[1], b[2] - a[2]
-        wx, wy, wz = cx - a[0], cy - a[1], cz - a[2]
-        ee = ex * ex + ey * ey + ez * ez
-        t = min(max((wx * ex + wy * ey + wz * ez) / ee, 0.0), 1.0) if ee > 0.0 else 0.0
-        return math.sqrt((wx - t * ex) ** 2 + (wy - t * ey) ** 2 + (wz - t * ez) ** 2) - bound
-
     def distance(self, x: float, y: float, z: float) -> float:
         """``sdf`` of one point in plain floats: the same formulas without numpy's cost per call
         (the sphere tracing asks one point at a time, issue 30 item 3)."""
@@ -179,14 +170,6 @@ class Body:
                 value = max(value, -cut.distance(x, y, z))
         return value
 
-    def nearest_first(self, a: tuple[float, float, float], b: tuple[float, float, float]) -> Body:
-        """The same body with its cut-outs in the order of their bounds' distance from the segment
-        a→b: along a path the cut-out the ball is in raises the value first, so the far ones fail
-        ``distance``'s bound test. The value is the same in any order (a maximum)."""
-        if len(self.cutouts) < 2:
-            return self
-        return Body(self.solid, tuple(sorted(self.cutouts, key=lambda cut: cut.segment_bound(a, b))))
-
 
 @dataclass(frozen=True)
 class ProtectionModel:
@@ -207,19 +190,14 @@ class ProtectionModel:
     def distance(self, x: float, y: float, z: float) -> tuple[float, str]:
         """``sdf`` in plain floats; a body whose bound is no nearer than the best so far is skipped
         (it cannot be the nearest)."""
-        return _distance(self.bodies, x, y, z)
-
-
-def _distance(bodies: tuple[Body, ...], x: float, y: float, z: float) -> tuple[float, str]:
-    """``ProtectionModel.distance`` of ``bodies`` (in the model's order: ties name the first)."""
-    best, name = math.inf, ""
-    for body in bodies:
-        if body.solid.lower_bound(x, y, z) >= best:
-            continue
-        v = body.distance(x, y, z)
-        if v < best:
-            best, name = v, body.name
-    return best, name
+        best, name = math.inf, ""
+        for body in self.bodies:
+            if body.solid.lower_bound(x, y, z) >= best:
+                continue
+            v = body.distance(x, y, z)
+            if v < best:
+                best, name = v, body.name
+        return best, name
 
 
 def first_contact(model: ProtectionModel, c0: npt.ArrayLike, c1: npt.ArrayLike, radius: float
@@ -233,11 +211,9 @@ def first_contact(model: ProtectionModel, c0: npt.ArrayLike, c1: npt.ArrayLike, 
     if length <= 0.0 or not model.bodies:
         return None
     dx, dy, dz = (bx - ax) / length, (by - ay) / length, (bz - az) / length
-    # the cut-outs near this path first (issue 30): the same distances, fewer evaluated
-    bodies = tuple(body.nearest_first((ax, ay, az), (bx, by, bz)) for body in model.bodies)
 
     def at(s: float) -> tuple[float, str]:
-        return _distance(bodies, ax + s * dx, ay + s * dy, az + s * dz)
+        return model.distance(ax + s * dx, ay + s * dy, az + s * dz)
 
     g, name = at(0.0)
     s = 0.0
