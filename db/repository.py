@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from datetime import UTC, datetime
 from typing import Any, TypeVar, cast
 
-from sqlalchemy import Insert, Row, Table, bindparam, delete, exists, func, insert, select
+from sqlalchemy import Insert, Row, Table, bindparam, delete, exists, func, insert, select, update
 from sqlalchemy.orm import Session
 
 from db.models import (
@@ -190,19 +190,34 @@ class Unit(PartsUnit, PlantUnit, ProbeEventsUnit):
         if slot is None:
             raise KeyError(name)
         values = _parse_frame(frame)
+        self._session.flush()                  # what the session holds is written first, in order
+        connection = self._session.connection()
         rows = self._frame_rows(name)
         before = _frame_from_rows(rows.values())
+        # prepared Core statements (issue 30), written as the ORM's unit of work wrote them: a
+        # column keeps its stored value unless the new one differs (==), an unchanged row is not
+        # written, a missing axis row is inserted with the defaults of _new_frame_axis
         for axis in AXES:
             if axis not in values and axis not in rows:
                 continue
+            coarse, fine, rot = values.get(axis, (0.0, 0.0, 0.0 if axis in GEOMETRY_AXES else None))
             row = rows.get(axis)
             if row is None:
-                row = rows[axis] = _new_frame_axis(slot, axis, self.machine)
-                self._session.add(row)
-            row.coarse, row.fine, row.rot = values.get(axis, (0.0, 0.0, 0.0 if axis in GEOMETRY_AXES else None))
+                connection.execute(_FRAME_AXIS_INSERT, {
+                    "machine": self.machine, "channel": CHANNEL, "name": slot.name, "kind": slot.kind,
+                    "frame_index": slot.index, "axis": axis, "coarse": coarse, "fine": fine, "rot": rot,
+                    "mirror": False, "scale": 1.0})
+            elif coarse != row.coarse or fine != row.fine or rot != row.rot:
+                coarse = coarse if coarse != row.coarse else row.coarse
+                fine = fine if fine != row.fine else row.fine
+                rot = rot if rot != row.rot else row.rot
+                connection.execute(_FRAME_AXIS_UPDATE, {"row_id": row.id, "coarse": coarse, "fine": fine, "rot": rot})
+            else:
+                continue
+            rows[axis] = _AxisValues(axis, coarse, fine, rot, row.id if row is not None else None)
         after = _frame_from_rows(rows.values())
         self.add_audit("offset", name, before, after, source, detail)
-        return copy.deepcopy(before), copy.deepcopy(after)
+        return before, after
 
     # --- audit trail -----------------------------------------------------------------------
 
@@ -240,8 +255,10 @@ class Unit(PartsUnit, PlantUnit, ProbeEventsUnit):
         row = self._session.get(OffsetAudit, audit_id)
         return None if row is None or row.machine != self.machine else _audit_dict(row)
 
-    def _frame_rows(self, name: str) -> dict[str, FrameAxis]:
-        rows = self._session.scalars(_FRAME_ROWS, {"machine": self.machine, "name": name})
+    def _frame_rows(self, name: str) -> dict[str, Any]:
+        """The stored axis rows of frame ``name`` as columns (no ORM objects: put_offset writes
+        them by Core statements)."""
+        rows = self._session.connection().execute(_FRAME_ROWS, {"machine": self.machine, "name": name})
         return {row.axis: row for row in rows}
 
     # --- tools ---------------------------------------------------------------------------
@@ -370,8 +387,11 @@ class Unit(PartsUnit, PlantUnit, ProbeEventsUnit):
         return self.get_settings()
 
     def get_state(self, key: str, default: Any = None) -> Any:
-        row = self._session.get(MachineState, self._key(key=key))
-        return default if row is None else copy.deepcopy(row.value)
+        # a prepared Core SELECT after a flush (what the session holds is what it reads): the
+        # value is decoded from its JSON, a new object for the caller
+        self._session.flush()
+        row = self._session.connection().execute(_STATE_VALUE, {"machine": self.machine, "key": key}).first()
+        return default if row is None else row[0]
 
     def set_state(self, key: str, value: Any) -> None:
         self._upsert(MachineState, key, value)
@@ -588,8 +608,26 @@ class _EndedTransaction:
 # --- row <-> dict helpers -------------------------------------------------------------------
 
 # prepared once (building a statement costs more than running it): the rows a measurement writes
-_FRAME_ROWS = select(FrameAxis).where(FrameAxis.machine == bindparam("machine"), FrameAxis.channel == CHANNEL,
-                                      FrameAxis.name == bindparam("name"))
+_FRAME_ROWS = (select(FrameAxis.axis, FrameAxis.coarse, FrameAxis.fine, FrameAxis.rot, FrameAxis.id)
+               .where(FrameAxis.machine == bindparam("machine"), FrameAxis.channel == CHANNEL,
+                      FrameAxis.name == bindparam("name")))
+_FRAMES_TABLE = cast(Table, FrameAxis.__table__)
+_FRAME_AXIS_INSERT = insert(_FRAMES_TABLE)
+_FRAME_AXIS_UPDATE = (update(_FRAMES_TABLE).where(_FRAMES_TABLE.c.id == bindparam("row_id"))
+                      .values(coarse=bindparam("coarse"), fine=bindparam("fine"), rot=bindparam("rot")))
+_STATE_VALUE = select(MachineState.value).where(MachineState.machine == bindparam("machine"),
+                                                MachineState.key == bindparam("key"))
+
+
+@dataclass(frozen=True)
+class _AxisValues:
+    """One frame axis as put_offset wrote it (the columns _frame_from_rows reads)."""
+
+    axis: str
+    coarse: float
+    fine: float
+    rot: float | None
+    id: int | None
 _AUDIT_INSERT = insert(cast(Table, OffsetAudit.__table__))
 _LOG_INSERT = insert(cast(Table, MeasurementLog.__table__))
 
@@ -601,7 +639,7 @@ def _new_frame_axis(slot: OffsetSlot, axis: str, machine: str) -> FrameAxis:
     )
 
 
-def _frame_from_rows(rows: Iterable[FrameAxis | Row[str, str, float, float, float | None]]) -> dict[str, Any]:
+def _frame_from_rows(rows: Iterable[Any]) -> dict[str, Any]:
     by_axis = {row.axis: row for row in rows}
     frame = identity_frame()
     for axis in AXES:
