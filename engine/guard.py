@@ -181,6 +181,10 @@ class ProtectionModel:
     bodies: tuple[Body, ...] = ()
     limits: dict[str, tuple[float, float]] = field(default_factory=dict)
     known: bool = True
+    # first_contact's answers for this model by their exact inputs (issue 30): a point measured
+    # again from where its last run ended (the probe returns to its start) asks the same paths
+    contacts: dict[tuple[float, ...], tuple[float, str] | None] = field(
+        default_factory=dict, compare=False, repr=False)
 
     def sdf(self, point: npt.ArrayLike) -> tuple[float, str]:
         """(distance, name of the nearest body) of one point."""
@@ -207,6 +211,23 @@ def first_contact(model: ProtectionModel, c0: npt.ArrayLike, c1: npt.ArrayLike, 
     or slides along the surface is free until its next contact; pressing deeper is s = 0."""
     ax, ay, az = (float(v) for v in np.asarray(c0, dtype=float))
     bx, by, bz = (float(v) for v in np.asarray(c1, dtype=float))
+    key = (ax, ay, az, bx, by, bz, float(radius))
+    known = model.contacts.get(key, _UNKNOWN)
+    if known is not _UNKNOWN:
+        return known            # type: ignore[return-value]  # the same inputs: the same answer
+    hit = _first_contact(model, ax, ay, az, bx, by, bz, float(radius))
+    if len(model.contacts) >= CONTACT_MEMO:
+        model.contacts.clear()
+    model.contacts[key] = hit
+    return hit
+
+
+_UNKNOWN = object()
+CONTACT_MEMO = 4096             # answers kept per model
+
+
+def _first_contact(model: ProtectionModel, ax: float, ay: float, az: float, bx: float, by: float, bz: float,
+                   radius: float) -> tuple[float, str] | None:
     length = math.sqrt((bx - ax) ** 2 + (by - ay) ** 2 + (bz - az) ** 2)
     if length <= 0.0 or not model.bodies:
         return None
