@@ -18,7 +18,7 @@ Mills and drills on a lathe: engine.turning_mills.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Generator, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -32,8 +32,8 @@ from engine.turning import (
     LatheMotion,
     LathePoint,
     LatheProgram,
-    LatheSteps,
     LatheTool,
+    LatheTouch,
     axis_of_ma,
     calibration_check,
     check_fa,
@@ -54,7 +54,7 @@ from engine.turning import (
     tp_to_list,
 )
 from engine.turning_offsets import tool_dict, tool_measure_update
-from engine.types import MeasuringError
+from engine.types import FloatArray, Latch, MeasuringError, Step
 
 _TOL = 1e-9
 
@@ -324,6 +324,64 @@ def _allowed(s: Mapping[str, int], axis: str) -> tuple[int, ...]:
     return (s[axis],) if s[axis] != 0 else (1, -1)
 
 
+@dataclass(frozen=True)
+class _ToolMoves:
+    """The moves of a turning tool (SL ``sl``, cutting radius ``r``) against the tool probe ``record``."""
+
+    m: LatheMotion
+    record: Mapping[str, float]
+    s: Mapping[str, int]
+    r: float
+    fa: float
+    feed: float
+    nmsp: int
+    p0: FloatArray
+    sl: int
+
+    def measure(self, a: str, d: int, tag: str) -> Generator[Step, Latch | None, LatheTouch]:
+        """Nose centre on the probe centre in the other axis, then probe ``a`` travelling ``d``."""
+        m, record, s, r, fa = self.m, self.record, self.s, self.r, self.fa
+        f = tp_face(record, key(a, d))
+        b = other_plane_axis(a)
+        yield from m.move_axis(b, tp_centre(record, b) + s[b] * r, f"{tag} nose centre on the probe centre")
+        yield from m.move_axis(a, f - leading_offset(d, s[a], r) - d * fa, f"{tag} start of probing")
+        touch = yield from m.touch(key(a, d), 2.0 * fa, self.feed, self.nmsp, f"{tag} {key(a, d)}", expected=fa,
+                                   role=tag)
+        return touch
+
+    def direction(self, a: str) -> int:
+        j = "XYZ".index(a)
+        return travel_direction(float(self.p0[j]), self.s[a], self.r, tp_face(self.record, key(a, -1)),
+                                tp_face(self.record, key(a, 1)), self.fa, _allowed(self.s, a),
+                                what=f"tool (SL {self.sl})")
+
+    def incremental(self, a: str, d: int, label: str) -> Generator[Step, Latch | None, LatheTouch]:
+        """Probe in _MA/_MD from the current position, back to the start."""
+        if d not in _allowed(self.s, a):
+            raise MeasuringError(alarms.TOOL_TIP_POSITION, f"SL {self.sl} cannot be measured travelling {key(a, d)}")
+        touch = yield from self.m.touch(key(a, d), 2.0 * self.fa, self.feed, self.nmsp, f"{label} {key(a, d)}",
+                                        role=label)
+        yield from self.m.move(self.m.start, f"{label} back to the start", returning=True)
+        return touch
+
+    def both_lengths(self) -> Generator[Step, Latch | None, list[LatheTouch]]:
+        """SL 1–4, automatic: (a)..(g) of turning_tool_program's docstring, L2 then L1."""
+        m, record, s, r, fa, p0 = self.m, self.record, self.s, self.r, self.fa, self.p0
+        dz, dx = self.direction("Z"), self.direction("X")
+        fz, fx = tp_face(record, key("Z", dz)), tp_face(record, key("X", dx))
+        yield from m.move_axis("X", tp_centre(record, "X") + s["X"] * r, "P1 (a) nose centre on the X centre")
+        yield from m.move_axis("Z", fz - leading_offset(dz, s["Z"], r) - dz * fa, "P1 (b) start of probing")
+        touches = [(yield from m.touch(key("Z", dz), 2.0 * fa, self.feed, self.nmsp, f"P1 {key('Z', dz)}",
+                                       expected=fa, role="P1"))]
+        yield from m.move_axis("X", fx - leading_offset(dx, s["X"], r) - dx * fa, "P2 (d) start of probing")
+        yield from m.move_axis("Z", tp_centre(record, "Z") + s["Z"] * r, "P2 (e) nose centre on the Z centre")
+        touches.append((yield from m.touch(key("X", dx), 2.0 * fa, self.feed, self.nmsp, f"P2 {key('X', dx)}",
+                                           expected=fa, role="P2")))
+        yield from m.move_axis("Z", float(p0[2]), "(g) back to the start Z", returning=True)
+        yield from m.move_axis("X", float(p0[0]), "(g) back to the start X", returning=True)
+        return touches
+
+
 def turning_tool_program(call: Cycle982, start: npt.ArrayLike, ctx: LatheContext, label: str = "P1") -> LatheProgram:
     """CYCLE982 _MVAR 1/11 (one length), 2/12 (automatic), 100001/100011 (incremental) for a
     turning tool SL 1..8 (turning.md §2.3).
@@ -345,48 +403,18 @@ def turning_tool_program(call: Cycle982, start: npt.ArrayLike, ctx: LatheContext
     feed = measuring_feed(call.vms, fa)
     p0 = np.asarray(start, float)
     m = LatheMotion(p0, ctx, _coords(variant))
-    touches = []
-
-    def measure(a: str, d: int, tag: str) -> LatheSteps:
-        f = tp_face(record, key(a, d))
-        b = other_plane_axis(a)
-        yield from m.move_axis(b, tp_centre(record, b) + s[b] * r, f"{tag} nose centre on the probe centre")
-        yield from m.move_axis(a, f - leading_offset(d, s[a], r) - d * fa, f"{tag} start of probing")
-        t = yield from m.touch(key(a, d), 2.0 * fa, feed, call.nmsp, f"{tag} {key(a, d)}", expected=fa, role=tag)
-        touches.append(t)
-
-    def direction(a: str) -> int:
-        j = "XYZ".index(a)
-        return travel_direction(float(p0[j]), s[a], r, tp_face(record, key(a, -1)), tp_face(record, key(a, 1)),
-                                fa, _allowed(s, a), what=f"tool (SL {tool.sl})")
-
+    moves = _ToolMoves(m, record, s, r, fa, feed, call.nmsp, p0, tool.sl)
+    touches: list[LatheTouch] = []
     if variant.incremental:
-        a = axis_of_ma(call.ma, (1, 2))
-        d = direction_of_md(call.md)
-        if d not in _allowed(s, a):
-            raise MeasuringError(alarms.TOOL_TIP_POSITION, f"SL {tool.sl} cannot be measured travelling {key(a, d)}")
-        t = yield from m.touch(key(a, d), 2.0 * fa, feed, call.nmsp, f"{label} {key(a, d)}", role=label)
-        touches.append(t)
-        yield from m.move(m.start, f"{label} back to the start", returning=True)
+        touches.append((yield from moves.incremental(axis_of_ma(call.ma, (1, 2)), direction_of_md(call.md), label)))
     elif variant.kind == "measure":
         a = axis_of_ma(call.ma, (1, 2))
-        yield from measure(a, direction(a), label)
+        touches.append((yield from moves.measure(a, moves.direction(a), label)))
     elif s["X"] != 0 and s["Z"] != 0:                                   # automatic, SL 1–4
-        dz, dx = direction("Z"), direction("X")
-        fz, fx = tp_face(record, key("Z", dz)), tp_face(record, key("X", dx))
-        yield from m.move_axis("X", tp_centre(record, "X") + s["X"] * r, "P1 (a) nose centre on the X centre")
-        yield from m.move_axis("Z", fz - leading_offset(dz, s["Z"], r) - dz * fa, "P1 (b) start of probing")
-        touches.append((yield from m.touch(key("Z", dz), 2.0 * fa, feed, call.nmsp, f"P1 {key('Z', dz)}",
-                                           expected=fa, role="P1")))
-        yield from m.move_axis("X", fx - leading_offset(dx, s["X"], r) - dx * fa, "P2 (d) start of probing")
-        yield from m.move_axis("Z", tp_centre(record, "Z") + s["Z"] * r, "P2 (e) nose centre on the Z centre")
-        touches.append((yield from m.touch(key("X", dx), 2.0 * fa, feed, call.nmsp, f"P2 {key('X', dx)}",
-                                           expected=fa, role="P2")))
-        yield from m.move_axis("Z", float(p0[2]), "(g) back to the start Z", returning=True)
-        yield from m.move_axis("X", float(p0[0]), "(g) back to the start X", returning=True)
+        touches += yield from moves.both_lengths()
     else:                                                               # automatic, SL 5–8: tip axis
         a = _tip_axis(s)
-        yield from measure(a, direction(a), "P1")
+        touches.append((yield from moves.measure(a, moves.direction(a), "P1")))
         yield from m.move_axis(a, float(p0["XYZ".index(a)]), "back to the start", returning=True)
         yield from m.move(p0, "back to the start", returning=True)
     return LathePoint(cycle=call.cycle, mvar=call.mvar, coords=m.coords, start=p0.copy(), touches=tuple(touches),

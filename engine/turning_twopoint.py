@@ -24,6 +24,8 @@ eccentricity in X cancels in s1 − s2 (both points at the same spindle angle).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import numpy.typing as npt
 
@@ -70,6 +72,66 @@ def _zone(call: WorkpieceCall, axis: str, ctx: LatheContext, y_like_x: bool) -> 
     return abs(to_radius(call.szo, axis, ctx.diamon, y_like_x))
 
 
+def _starts_inside(call: WorkpieceCall, c0: float, half: float, expected_inside: bool | None) -> bool:
+    """Whether the probe starts inside the diameter (ball centre ``c0`` on the measuring axis);
+    61307 where it stands beyond the negative point or contradicts the task or _MVAR."""
+    if c0 > half:
+        inside = False
+    elif -half < c0 < half:
+        inside = True
+    else:
+        raise MeasuringError(alarms.WRONG_VARIANT, "CYCLE994: the probe must start opposite the positive "
+                                                   "measuring point (turning.md §6.3)")
+    if expected_inside is not None and bool(expected_inside) != inside:
+        raise MeasuringError(alarms.WRONG_VARIANT, f"the probe starts {'inside' if inside else 'outside'} the "
+                                                   "diameter, contradicting the task's `inside` (turning.md §6.3)")
+    if call.mvar == 1 and not inside:
+        raise MeasuringError(alarms.WRONG_VARIANT, "_MVAR=1 measures an inside diameter, but the probe starts "
+                                                   "outside (turning.md §6.3)")
+    return inside
+
+
+@dataclass(frozen=True)
+class _Route:
+    """From P1 to the start of P2 (at ``q2`` on the measuring axis ``a``) around the part."""
+
+    m: LatheMotion
+    call: WorkpieceCall
+    ctx: LatheContext
+    a: str
+    q2: float
+    measuring_cross: float
+    label: str
+
+    def via_zone(self) -> LatheSteps:
+        m, a, q2, cross, label = self.m, self.a, self.q2, self.measuring_cross, self.label
+        if a == "Z":                                        # via X to the zone on the probe's side
+            side = 1.0 if cross >= 0.0 else -1.0
+            limit = _zone(self.call, "X", self.ctx, False)
+            out = side * max(side * float(m.ball_pos()[0]), limit)
+            yield from m.move_axis("X", out, f"{label} detour X", ball=True)
+            yield from m.move_axis("Z", q2, f"{label}2 start of probing", ball=True)
+            yield from m.move_axis("X", cross, f"{label}2 back to the measuring X", ball=True)
+        else:
+            yield from m.move_axis("Z", abs(float(self.call.sza)), f"{label} detour Z", ball=True)
+            yield from m.move_axis(a, q2, f"{label}2 start of probing", ball=True)
+            yield from m.move_axis("Z", cross, f"{label}2 back to the measuring Z", ball=True)
+
+    def around_od(self, zone: float, clearance: float) -> LatheSteps:
+        """An outside diameter: up to the protection zone ``zone`` (beyond the measuring point +
+        ball radius ``clearance``), over in Z, down beyond the far side, back to the measuring Z."""
+        m, a, label = self.m, self.a, self.label
+        if not zone > clearance:
+            raise MeasuringError(alarms.PROTECTION_ZONE, f"protection zone {zone:g} must exceed the measuring "
+                                                         f"point + ball radius {clearance:g} (turning.md §6.3)")
+        yield from m.move_axis(a, max(float(m.ball_pos()[index(a)]), zone), f"{label} detour: up to the zone",
+                               ball=True)
+        yield from m.move_axis("Z", abs(float(self.call.sza)), f"{label} detour Z", ball=True)
+        yield from m.move_axis(a, -zone, f"{label} detour: down to the zone", ball=True)
+        yield from m.move_axis("Z", self.measuring_cross, f"{label} detour: back to the measuring Z", ball=True)
+        yield from m.move_axis(a, self.q2, f"{label}2 start of probing", ball=True)
+
+
 def two_point_program(call: WorkpieceCall, start: npt.ArrayLike, ctx: LatheContext, label: str = "P",
                       target: ToolTarget | None = None, inside: bool | None = None) -> LatheProgram:
     """The point program of CYCLE994 (module docstring). Returns a LathePoint with the touches
@@ -89,20 +151,7 @@ def two_point_program(call: WorkpieceCall, start: npt.ArrayLike, ctx: LatheConte
     if not half > 0.0:
         raise ValueError(f"CYCLE994 needs _SETVAL > 0, got {call.setval!r}")
     ball0 = m.ball_pos()
-    c0 = float(ball0[j])
-    if c0 > half:
-        inside = False
-    elif -half < c0 < half:
-        inside = True
-    else:
-        raise MeasuringError(alarms.WRONG_VARIANT, "CYCLE994: the probe must start opposite the positive "
-                                                   "measuring point (turning.md §6.3)")
-    if expected_inside is not None and bool(expected_inside) != inside:
-        raise MeasuringError(alarms.WRONG_VARIANT, f"the probe starts {'inside' if inside else 'outside'} the "
-                                                   "diameter, contradicting the task's `inside` (turning.md §6.3)")
-    if call.mvar == 1 and not inside:
-        raise MeasuringError(alarms.WRONG_VARIANT, "_MVAR=1 measures an inside diameter, but the probe starts "
-                                                   "outside (turning.md §6.3)")
+    inside = _starts_inside(call, float(ball0[j]), half, expected_inside)
     d1 = 1 if inside else -1
     k1, k2 = key(a, d1), key(a, -d1)
     check_probe_direction(chk.probe.sl, k1)
@@ -115,36 +164,15 @@ def two_point_program(call: WorkpieceCall, start: npt.ArrayLike, ctx: LatheConte
     detour = "X" if a == "Z" else "Z"
     measuring_cross = float(ball0[index(detour)])
     info = {"axis": a, "inside": inside, "setpoint_radius": half, "keys": (k1, k2)}
-
-    def cross_via_zone() -> LatheSteps:
-        if a == "Z":                                        # via X to the zone on the probe's side
-            side = 1.0 if measuring_cross >= 0.0 else -1.0
-            limit = _zone(call, "X", ctx, False)
-            out = side * max(side * float(m.ball_pos()[0]), limit)
-            yield from m.move_axis("X", out, f"{label} detour X", ball=True)
-            yield from m.move_axis("Z", q2, f"{label}2 start of probing", ball=True)
-            yield from m.move_axis("X", measuring_cross, f"{label}2 back to the measuring X", ball=True)
-        else:
-            yield from m.move_axis("Z", abs(float(call.sza)), f"{label} detour Z", ball=True)
-            yield from m.move_axis(a, q2, f"{label}2 start of probing", ball=True)
-            yield from m.move_axis("Z", measuring_cross, f"{label}2 back to the measuring Z", ball=True)
-
     yield from m.move_axis(a, q1, f"{label}1 start of probing", ball=True)
     p1 = yield from m.touch(k1, 2.0 * fa, feed, call.nmsp, f"{label}1 {k1}", expected=fa, role=f"{label}1")
+    route = _Route(m, call, ctx, a, q2, measuring_cross, label)
     if inside and call.mvar == 2:
         yield from m.move_axis(a, q2, f"{label}2 start of probing", ball=True)         # across at the measuring Z
     elif inside or a == "Z":
-        yield from cross_via_zone()
+        yield from route.via_zone()
     else:                                                   # OD with the protection zone (figure steps 3–7)
-        zone = _zone(call, a, ctx, chk.y_like_x)
-        if not zone > half + r:
-            raise MeasuringError(alarms.PROTECTION_ZONE, f"protection zone {zone:g} must exceed the measuring "
-                                                         f"point + ball radius {half + r:g} (turning.md §6.3)")
-        yield from m.move_axis(a, max(float(m.ball_pos()[j]), zone), f"{label} detour: up to the zone", ball=True)
-        yield from m.move_axis("Z", abs(float(call.sza)), f"{label} detour Z", ball=True)
-        yield from m.move_axis(a, -zone, f"{label} detour: down to the zone", ball=True)
-        yield from m.move_axis("Z", measuring_cross, f"{label} detour: back to the measuring Z", ball=True)
-        yield from m.move_axis(a, q2, f"{label}2 start of probing", ball=True)
+        yield from route.around_od(_zone(call, a, ctx, chk.y_like_x), half + r)
     p2 = yield from m.touch(k2, 2.0 * fa, feed, call.nmsp, f"{label}2 {k2}", expected=fa, role=f"{label}2")
     return LathePoint(cycle=994, mvar=call.mvar, coords="WCS", start=p0.copy(), touches=(p1, p2), info=info)
 
