@@ -389,3 +389,20 @@ def test_6_3_3_a_mill_on_the_lathe_is_refused_with_a_turning_tool(lathe):
     assert answer["alarm"]["code"] == 61307 and "mill digits with a turning tool" in answer["alarm"]["message"]
     assert lathe.tool(3) == before
     assert lathe.var("_OVI")[9] == 61307
+
+
+@pytest.mark.parametrize(("call", "code", "text"), [
+    ("_MVAR=5 _MA=2 _SETVAL=45\nN30 CYCLE974", 61307, "CYCLE974 measures 0"),
+    ("_MVAR=3 _MA=2 _SETVAL=45\nN30 CYCLE994", 61307, "CYCLE994 measures 1"),
+    ("_MVAR=0 _MA=4 _SETVAL=45\nN30 CYCLE974", 61325, "_MA = 4"),
+    ("_MVAR=13 _MA=1 _MD=1 _CALNUM=0\nN30 CYCLE973", 65103, "_CALNUM = 0"),
+])
+def test_a_wrong_parameter_alarms_at_the_call_and_nothing_moves(lathe, call, code, text):
+    """A variant or parameter the cycle does not have stops the program at the call with the
+    cycle's alarm naming the parameter; the probe stays where the program put it."""
+    answer = lathe.ok(lathe.c.post("/api/nc/run", json={"mda": f"N10 T8 D1 G54 G90 DIAMON G0 Z100 X160\nN20 {call}"}))
+    assert answer["state"] == "alarm" and answer["block"]["number"] == 30, answer
+    assert answer["alarm"]["code"] == code
+    assert text in answer["alarm"]["message"]
+    assert lathe.ok(lathe.c.get("/api/machine"))["wcs"]["X"] == pytest.approx(160.0)
+    assert lathe.ok(lathe.c.get("/api/machine"))["wcs"]["Z"] == pytest.approx(100.0)
