@@ -10,7 +10,6 @@ from typing import Protocol
 
 from asgi_csrf import asgi_csrf
 from fastapi import FastAPI
-from fastapi.staticfiles import StaticFiles
 from starlette.routing import Mount, Route
 
 from app import openapi_doc
@@ -56,11 +55,11 @@ from app.services.probe_test import ProbeTestService
 from app.services.scenarios import read_scenario
 from app.web import web_router
 from app.web.language import LanguageMiddleware
+from app.web.static_files import STATIC_DIR, VersionedStaticFiles
 from app.workflow.service import WorkflowService
 from db import Database
 
 ROOT = Path(__file__).resolve().parent.parent
-STATIC_DIR = ROOT / "static"
 
 
 def machine_options(settings: Settings) -> dict:
@@ -169,7 +168,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.add_middleware(LanguageMiddleware)          # the screens' language (app/web/language.py)
     app.include_router(api_router)
     app.include_router(web_router)
-    app.mount("/static", StaticFiles(directory=STATIC_DIR), name="static")
+    app.mount("/static", VersionedStaticFiles(directory=STATIC_DIR), name="static")
     openapi_doc.install(app, public_paths={r.path for r in _flat_routes(app)
                                             if isinstance(r.route if hasattr(r, "original_route") else r, Route | Mount)
                                             and r.name in PUBLIC_ROUTES})

@@ -27,6 +27,7 @@ from app.gud import GudSettings
 from app.i18n import N_, format_fixed
 from app.web import texts, units
 from app.web.panel_state import PanelState
+from app.web.static_files import versioned
 
 TEMPLATES_DIR = Path(__file__).resolve().parents[2] / "templates"
 SCREEN_BLOCKS = ["screen", "vsoftkeys", "hsoftkeys"]
@@ -73,7 +74,8 @@ def url_path(request: Request, route: str, /, **path_params) -> str:
         path = _route_index(request.app)[route].url_path_for(route, **path_params)
     except (KeyError, NoMatchFound):
         path = request.app.url_path_for(route, **path_params)      # the router's own lookup and its error
-    return request.scope.get("root_path", "").rstrip("/") + str(path)
+    query = versioned(path_params["path"]) if route == "static" else ""   # kept by the browser (static_files)
+    return request.scope.get("root_path", "").rstrip("/") + str(path) + query
 
 
 @pass_context
