@@ -275,6 +275,42 @@ def evaluate_probe_calibration(call: Cycle973, point: LathePoint, ctx: LatheCont
     """
     c = check_973(call, ctx)
     old = c.record
+    triggers, new_skew, d_eff = _measured(c, point, ctx, call)
+    # turning §0.11 calibration rule, every value checked before anything is stored
+    stored: list[str] = []
+    stored_values, differences = _checked_triggers(triggers, old, call, stored)
+    skew_out = dict(old.skew)
+    if new_skew is not None:
+        value, changed = calibration_check(new_skew, float(old.skew.get(c.axis, 0.0)), call.tzl, call.tsa,
+                                           f"position deviation {c.axis}")
+        skew_out[c.axis] = value
+        differences[f"skew {c.axis}"] = new_skew - float(old.skew.get(c.axis, 0.0))
+        if changed:
+            stored.append(f"skew {c.axis}")
+    d_out = old.effective_diameter
+    if d_eff is not None:
+        d_out = _checked_diameter(d_eff, old.effective_diameter, 2.0 * c.r, call, stored)
+        differences["diameter"] = d_eff - (old.effective_diameter or 2.0 * c.r)
+    trig = dict(old.trigger)
+    trig.update(stored_values)
+    record = old.replace(trigger=trig, skew=skew_out, effective_diameter=d_out)
+    ovr, ovi = _calibration_ovr(call, record, triggers, differences, d_eff)
+    values: dict[str, Any] = {"probe": record.to_dict(), "trigger": dict(triggers),
+              "difference": {k: differences[k] for k in triggers}, "stored": list(stored)}
+    if new_skew is not None:
+        values["skew"] = {c.axis: new_skew}
+    if d_eff is not None:
+        values["effective_diameter"] = d_eff
+    return ProbeCalibrationResult(record=record, trigger=dict(triggers), difference=differences,
+                                  stored=tuple(stored), skew={c.axis: new_skew} if new_skew is not None else {},
+                                  effective_diameter=d_eff, values=values, ovr=tuple(ovr), ovi=tuple(ovi))
+
+
+def _measured(c: Checked973, point: LathePoint, ctx: LatheContext, call: Cycle973
+              ) -> tuple[dict[str, float], float | None, float | None]:
+    """(trigger value per direction, the new skew of the axis or None, the effective ball diameter
+    or None) from the touches (turning.md §4.4)."""
+    old = c.record
     e = {"Z": float(old.skew.get("Z", 0.0)), "X": float(old.skew.get("X", 0.0)), "Y": 0.0}
     by_key = {t.key: t for t in point.touches}
     if c.variant.surface:
@@ -292,9 +328,14 @@ def evaluate_probe_calibration(call: Cycle973, point: LathePoint, ctx: LatheCont
     d_eff = None
     if c.variant.ball:
         d_eff = triggers[key(c.axis, -1)] - triggers[key(c.axis, 1)]            # independent of the skew
-    # turning §0.11 calibration rule, every value checked before anything is stored
+    return triggers, new_skew, d_eff
+
+
+def _checked_triggers(triggers: dict[str, float], old: LatheProbe, call: Cycle973, stored: list[str]
+                      ) -> tuple[dict[str, float], dict[str, float]]:
+    """(the trigger values to store, the differences to the stored ones); the directions whose
+    value is written are appended to ``stored``."""
     stored_values: dict[str, float] = {}
-    stored: list[str] = []
     differences: dict[str, float] = {}
     for k, t in triggers.items():
         value, changed = calibration_check(t, old.trigger_value(k), call.tzl, call.tsa, f"trigger value {k}")
@@ -302,21 +343,11 @@ def evaluate_probe_calibration(call: Cycle973, point: LathePoint, ctx: LatheCont
         differences[k] = t - old.trigger_value(k)
         if changed:
             stored.append(k)
-    skew_out = dict(old.skew)
-    if new_skew is not None:
-        value, changed = calibration_check(new_skew, float(old.skew.get(c.axis, 0.0)), call.tzl, call.tsa,
-                                           f"position deviation {c.axis}")
-        skew_out[c.axis] = value
-        differences[f"skew {c.axis}"] = new_skew - float(old.skew.get(c.axis, 0.0))
-        if changed:
-            stored.append(f"skew {c.axis}")
-    d_out = old.effective_diameter
-    if d_eff is not None:
-        d_out = _checked_diameter(d_eff, old.effective_diameter, 2.0 * c.r, call, stored)
-        differences["diameter"] = d_eff - (old.effective_diameter or 2.0 * c.r)
-    trig = dict(old.trigger)
-    trig.update(stored_values)
-    record = old.replace(trigger=trig, skew=skew_out, effective_diameter=d_out)
+    return stored_values, differences
+
+
+def _calibration_ovr(call: Cycle973, record: LatheProbe, triggers: dict[str, float], differences: dict[str, float],
+                     d_eff: float | None) -> tuple[list[float], list[int]]:
     ovr, ovi = ovr_list(), ovi_list()
     slots = {"Z-": 8, "Z+": 10, "X-": 12, "X+": 14, "Y-": 16, "Y+": 18}      # [L20296–L20320]
     for k, i in slots.items():
@@ -329,15 +360,7 @@ def evaluate_probe_calibration(call: Cycle973, point: LathePoint, ctx: LatheCont
     ovr[20], ovr[21] = float(record.skew.get("Z", 0.0)), float(record.skew.get("X", 0.0))
     ovr[27], ovr[28] = float(call.tzl), float(call.tsa)
     ovi[2], ovi[3], ovi[5] = 973, int(call.mvar), int(call.prnum)
-    values: dict[str, Any] = {"probe": record.to_dict(), "trigger": dict(triggers),
-              "difference": {k: differences[k] for k in triggers}, "stored": list(stored)}
-    if new_skew is not None:
-        values["skew"] = {c.axis: new_skew}
-    if d_eff is not None:
-        values["effective_diameter"] = d_eff
-    return ProbeCalibrationResult(record=record, trigger=dict(triggers), difference=differences,
-                                  stored=tuple(stored), skew={c.axis: new_skew} if new_skew is not None else {},
-                                  effective_diameter=d_eff, values=values, ovr=tuple(ovr), ovi=tuple(ovi))
+    return ovr, ovi
 
 
 __all__ = ["Cycle973", "Groove", "ProbeCalibrationResult", "Variant973", "check_973", "decode_973",

@@ -137,6 +137,32 @@ def screen_model(workflow: WorkflowService, machine, session_id: str) -> dict:
 def carry_out(workflow: WorkflowService, machine, session_id: str, choices: Choices, db=None) -> dict:
     """NC Start on the activation screen: carry out what the toggles say (jog-measuring §6.2)."""
     session, support = _support_of(workflow, session_id)
+    _refuse_start(session, support, machine)
+    codes = codes_of(support)
+    target = support["target"]
+    actions: list[str] = []
+    messages: list[str] = []
+    activated = _activate(machine, target, db, actions, messages) if choices.activate else None
+    moved = False
+    if "realign" in codes and choices.realign:
+        if machine.has_swivel():
+            _realign(machine, choices, actions, messages)
+            moved = True
+        else:
+            messages.append(TEXT_NO_SWIVEL)
+    if "rotary" in codes and choices.position_rotary:
+        _position_rotary(machine, support, actions, messages)
+        moved = True
+    support["done"] = True
+    support["carried_out"] = {"choices": choices.__dict__, "actions": actions}
+    return {"done": True, "target": target, "activated": activated, "actions": actions,
+            "messages": messages, "axis_motion": moved,
+            "next_measuring_wo": machine.active_offset,
+            "machine": machine.status()}
+
+
+def _refuse_start(session, support: dict, machine) -> None:
+    """NC Start refused: already carried out or left, the machine moving, an alarm shown."""
     if support.get("done"):
         raise WorkflowError(409, "setup_support_done", "the set-up support was already carried out or left")
     if session.running or machine.machine.status().busy:
@@ -144,62 +170,48 @@ def carry_out(workflow: WorkflowService, machine, session_id: str, choices: Choi
     alarms = machine.machine.status().alarms
     if alarms:
         raise WorkflowError(409, "alarm", f"{alarms[-1].code} {alarms[-1].text}: press Reset first")
-    codes = codes_of(support)
-    target = support["target"]
-    swivel = machine.has_swivel()
-    actions: list[str] = []
-    messages: list[str] = []
-    activated = None
-    moved = False
 
-    if choices.activate:
-        if target.startswith("BASIC") or target.startswith("NCBASIC"):
-            machine.refresh_frame()          # basic frames are always part of the active chain
-            activated = machine.active_offset
-        else:
-            machine.activate(target)
-            activated = target
-        actions.append("activate")
-        messages.append(TEXT_ACTIVATED.format(wo=activated))
-        if db is not None:
-            with db.unit() as unit:
-                unit.set_state(STATE_CHAIN_WO, activated)
 
-    if "realign" in codes and choices.realign:
-        if swivel:
-            try:
-                if choices.retract:
-                    machine.retract_tool_axis()
-                    actions.append("retract")
-                    moved = True
-                status = machine.swivel_to_wcs()
-            except AlarmError as exc:
-                raise WorkflowError(409, "alarm", f"{exc}: the probe was not re-aligned (press Reset; "
-                                    "retract or move clear, then NC Start again)") from None
-            actions.append("realign")
-            moved = True
-            head = machine.head_axes()
-            angles = ", ".join(f"{a}={status['mcs'][a]:.4f} deg" for a in head)
-            messages.append(TEXT_REALIGNED.format(axis=machine.plane().infeed, wo=machine.active_offset,
-                                                  angles=angles))
-        else:
-            messages.append(TEXT_NO_SWIVEL)
+def _activate(machine, target: str, db, actions: list[str], messages: list[str]) -> str:
+    """The target WO activated (a basic frame: the chain refreshed); the chain's WO stored."""
+    if target.startswith("BASIC") or target.startswith("NCBASIC"):
+        machine.refresh_frame()          # basic frames are always part of the active chain
+        activated = machine.active_offset
+    else:
+        machine.activate(target)
+        activated = target
+    actions.append("activate")
+    messages.append(TEXT_ACTIVATED.format(wo=activated))
+    if db is not None:
+        with db.unit() as unit:
+            unit.set_state(STATE_CHAIN_WO, activated)
+    return activated
 
-    if "rotary" in codes and choices.position_rotary:
-        reason = next(r for r in support["reasons"] if r["code"] == "rotary")
-        axis, move = reason["axis"], float(reason["move"])
-        start = float(machine.machine.status().mcs[axis])
-        machine.goto({axis: start + move}, coords="MCS")
-        actions.append(f"position {axis}")
-        messages.append(f"Rotary axis {axis} turned by {move:.4f}° to {start + move:.4f}°")
-        moved = True
 
-    support["done"] = True
-    support["carried_out"] = {"choices": choices.__dict__, "actions": actions}
-    return {"done": True, "target": target, "activated": activated, "actions": actions,
-            "messages": messages, "axis_motion": moved,
-            "next_measuring_wo": machine.active_offset,
-            "machine": machine.status()}
+def _realign(machine, choices: Choices, actions: list[str], messages: list[str]) -> None:
+    """The probe swivelled perpendicular to the active WO's plane (retracted first when chosen)."""
+    try:
+        if choices.retract:
+            machine.retract_tool_axis()
+            actions.append("retract")
+        status = machine.swivel_to_wcs()
+    except AlarmError as exc:
+        raise WorkflowError(409, "alarm", f"{exc}: the probe was not re-aligned (press Reset; "
+                            "retract or move clear, then NC Start again)") from None
+    actions.append("realign")
+    head = machine.head_axes()
+    angles = ", ".join(f"{a}={status['mcs'][a]:.4f} deg" for a in head)
+    messages.append(TEXT_REALIGNED.format(axis=machine.plane().infeed, wo=machine.active_offset, angles=angles))
+
+
+def _position_rotary(machine, support: dict, actions: list[str], messages: list[str]) -> None:
+    """The rotary axis turned by the move the support proposed."""
+    reason = next(r for r in support["reasons"] if r["code"] == "rotary")
+    axis, move = reason["axis"], float(reason["move"])
+    start = float(machine.machine.status().mcs[axis])
+    machine.goto({axis: start + move}, coords="MCS")
+    actions.append(f"position {axis}")
+    messages.append(f"Rotary axis {axis} turned by {move:.4f}° to {start + move:.4f}°")
 
 
 GUIDED_STATE = "tilted_setup"      # guided tilted set-up: {"target": "G54", "since": last log id}
