@@ -420,6 +420,39 @@ def _sphere_points(points_3d: npt.ArrayLike, radius: float | None, has_center0: 
     return pts, q, scale, coplanar
 
 
+def _free_sphere(q: FloatArray) -> _ResidualJac:
+    """Residuals |p_i − c| − R and their Jacobian of the sphere x = (c, R) through the points ``q``."""
+
+    def free(x: FloatArray) -> tuple[FloatArray, FloatArray]:
+        diff = q - x[:3]
+        dist = np.linalg.norm(diff, axis=1)
+        dist = np.where(dist == 0.0, np.finfo(float).tiny, dist)
+        return dist - x[3], np.column_stack([-diff / dist[:, None], -np.ones(len(q))])
+
+    return free
+
+
+def _sphere_of_radius(q: FloatArray, radius: float) -> _ResidualJac:
+    """Residuals |p_i − c| − ``radius`` and their Jacobian of the centre x = c."""
+
+    def centre_only(x: FloatArray) -> tuple[FloatArray, FloatArray]:
+        diff = q - x
+        dist = np.linalg.norm(diff, axis=1)
+        dist = np.where(dist == 0.0, np.finfo(float).tiny, dist)
+        return dist - radius, -diff / dist[:, None]
+
+    return centre_only
+
+
+def _algebraic_sphere(q: FloatArray) -> FloatArray:
+    """(c, R) of ``[2x 2y 2z 1]·[c, R² − |c|²] = |p|²``: the geometric fit's start."""
+    a_mat = np.column_stack([2.0 * q, np.ones(len(q))])
+    sol, *_ = np.linalg.lstsq(a_mat, np.sum(q * q, axis=1), rcond=None)
+    c_alg = sol[:3]
+    r_alg = float(np.sqrt(max(sol[3] + c_alg @ c_alg, 0.0)))
+    return np.concatenate([c_alg, [r_alg]])
+
+
 def fit_sphere(points_3d: npt.ArrayLike, *, radius: float | None = None, center0: npt.ArrayLike | None = None,
                sigma: float | None = None) -> SphereFit:
     """Sphere through n points in space (measuring-math §13.2, CYCLE997).
@@ -443,24 +476,9 @@ def fit_sphere(points_3d: npt.ArrayLike, *, radius: float | None = None, center0
     mean = pts.mean(axis=0)
     r_given = float("nan") if radius is None else float(radius)
 
-    def free(x: FloatArray) -> tuple[FloatArray, FloatArray]:
-        diff = q - x[:3]
-        dist = np.linalg.norm(diff, axis=1)
-        dist = np.where(dist == 0.0, np.finfo(float).tiny, dist)
-        return dist - x[3], np.column_stack([-diff / dist[:, None], -np.ones(len(q))])
-
-    def centre_only(x: FloatArray) -> tuple[FloatArray, FloatArray]:
-        diff = q - x
-        dist = np.linalg.norm(diff, axis=1)
-        dist = np.where(dist == 0.0, np.finfo(float).tiny, dist)
-        return dist - r_given, -diff / dist[:, None]
-
+    free, centre_only = _free_sphere(q), _sphere_of_radius(q, r_given)
     if not coplanar:
-        a_mat = np.column_stack([2.0 * q, np.ones(len(q))])
-        sol, *_ = np.linalg.lstsq(a_mat, np.sum(q * q, axis=1), rcond=None)
-        c_alg = sol[:3]
-        r_alg = float(np.sqrt(max(sol[3] + c_alg @ c_alg, 0.0)))
-        x_free = _gauss_newton(free, np.concatenate([c_alg, [r_alg]]), scale)
+        x_free = _gauss_newton(free, _algebraic_sphere(q), scale)
     if fixed:
         start = (np.asarray(center0, dtype=float) - mean) if center0 is not None else x_free[:3]
         if start.shape != (3,) or not np.all(np.isfinite(start)):
