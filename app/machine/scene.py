@@ -327,11 +327,18 @@ def _subtract(piece: tuple[float, float], cut: tuple[float, float], length: floa
     return out
 
 
+_UNKNOWN = object()
+CONTACT_MEMO = 4096             # first_contact answers kept per scene
+
+
 class Scene:
     """Union of bodies. All coordinates MCS, mm."""
 
     def __init__(self, bodies: list[Body] | None = None) -> None:
         self.bodies = list(bodies or [])
+        # first_contact's answers by their exact inputs (issue 30): the probe measuring a point
+        # again from where the last run ended travels the same paths until its first latch
+        self._contacts: dict[tuple[float, ...], float | None] = {}
 
     def subset(self, kinds) -> Scene:
         return Scene([b for b in self.bodies if b.kind in kinds])
@@ -378,6 +385,17 @@ class Scene:
         A ball that starts in contact (a deflected probe) may move away or slide along the
         surface; moving deeper into the material is a contact at s = 0.
         """
+        key = (*_xyz(center0), *_xyz(direction), float(max_distance), float(radius))
+        known = self._contacts.get(key, _UNKNOWN)
+        if known is not _UNKNOWN:
+            return known        # type: ignore[return-value]  # the same path: the same answer
+        found = self._first_contact(center0, direction, max_distance, radius)
+        if len(self._contacts) >= CONTACT_MEMO:
+            self._contacts.clear()
+        self._contacts[key] = found
+        return found
+
+    def _first_contact(self, center0, direction, max_distance: float, radius: float) -> float | None:
         d = np.asarray(direction, dtype=float)
         norm = float(np.linalg.norm(d))
         if not norm > 0.0:
