@@ -406,14 +406,7 @@ class LinuxCncMachine:
         lc = self._lc
         deadline = time.monotonic() + timeout
         if start is not None:
-            begun = time.monotonic() + BEGIN_S
-            while time.monotonic() < begun and not (self._abort.is_set() or self._stop.is_set()):
-                s = self._stat()
-                if s.interp_state != lc.INTERP_IDLE or s.queue > 0 or np.any(self._position() != start):
-                    break
-                if seq is not None and self._tripped(seq):
-                    break
-                time.sleep(POLL_S / 2)
+            self._wait_begun(start, seq)
         last, still = None, 0
         while True:
             s = self._stat()
@@ -434,6 +427,19 @@ class LinuxCncMachine:
         if self._stop.is_set():
             return "stop"
         return "done"
+
+    def _wait_begun(self, start: np.ndarray, seq: int | None) -> None:
+        """Until the motion of a block from ``start`` is seen to begin (``_wait_motion``), a Reset
+        or a stop, or at most BEGIN_S."""
+        lc = self._lc
+        begun = time.monotonic() + BEGIN_S
+        while time.monotonic() < begun and not (self._abort.is_set() or self._stop.is_set()):
+            s = self._stat()
+            if s.interp_state != lc.INTERP_IDLE or s.queue > 0 or np.any(self._position() != start):
+                return
+            if seq is not None and self._tripped(seq):
+                return
+            time.sleep(POLL_S / 2)
 
     def _mdi(self, line: str, timeout: float = 10.0, start: np.ndarray | None = None,
              seq: int | None = None, travel: float = 0.0) -> tuple[list[str], str]:
@@ -725,12 +731,7 @@ class LinuxCncMachine:
             self._check_limits(end)
             override = self._override
             event = self._event(start, d, distance)
-            s_arm = None
-            if event is not None:
-                s_arm = event.s_switch if event.kind == "switch" else event.s_contact
-                sigma = self._scenario.probe.noise_sigma
-                if event.kind == "switch" and self._is_probe() and sigma > 0.0:
-                    s_arm = max(0.0, s_arm + float(self._rng.normal(0.0, sigma)))
+            s_arm = self._arm_distance(event)
             seq = self._arm(start, d, s_arm)
             program = self._program_point(end)
             words = " ".join(f"{a}{_num(v)}" for a, v in zip(GEOMETRY_AXES, program, strict=True))
@@ -745,9 +746,7 @@ class LinuxCncMachine:
                                    "planned_end": end.tolist(), "direction": d.tolist(), "s_switch": s_arm,
                                    "event": None if event is None else event.kind, "s": float(self._pin("s")),
                                    "armed": int(self._pin("armed")), "seq": seq, "errors": errors}
-                if errors:
-                    raise MachineAlarm(self._raise(self._controller_alarm(errors)))
-                return ProbeResult(False, None, self._kin.as_dict(reached), feed, override)
+                return self._missed(errors, reached, feed, override)
             if event is None or event.kind == "crash":
                 raise MachineAlarm(self._raise(Alarm.of(alarms.PROBE_COLLISION, event.text if event
                                                         else "Probe collision")))
@@ -762,6 +761,23 @@ class LinuxCncMachine:
             return ProbeResult(True, self._kin.as_dict(latched), self._kin.as_dict(reached), feed, override)
         finally:
             self._finish()
+
+    def _arm_distance(self, event: Event | None) -> float | None:
+        """Where along the probing the comparator is armed to switch: the scenario's switching
+        point (with the probe's noise) or its contact; None without an event."""
+        if event is None:
+            return None
+        s_arm = event.s_switch if event.kind == "switch" else event.s_contact
+        sigma = self._scenario.probe.noise_sigma
+        if event.kind == "switch" and self._is_probe() and sigma > 0.0:
+            s_arm = max(0.0, s_arm + float(self._rng.normal(0.0, sigma)))
+        return s_arm
+
+    def _missed(self, errors: list[str], reached: np.ndarray, feed: float, override: float) -> ProbeResult:
+        """A probing that did not switch: LinuxCNC's errors as an alarm, else the miss."""
+        if errors:
+            raise MachineAlarm(self._raise(self._controller_alarm(errors)))
+        return ProbeResult(False, None, self._kin.as_dict(reached), feed, override)
 
     def _program_point(self, mcs: np.ndarray) -> np.ndarray:
         """Machine coordinates -> LinuxCNC's active program coordinates.
