@@ -1059,6 +1059,33 @@ def calibration_jacobian(estimator: str = "ls", *, diameter: float = 25.0, ball_
     return {"matrix": np.column_stack(cols), "rows": ("skew_X", "skew_Y", *[f"rho_{k}" for k in keys])}
 
 
+def _corner_sensitivities(jac: FloatArray, rot: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """ξ = A_cal·ν_cal + A_touch·ν_touch over (12 calibration touches, P1, P2, P3): (A_cal, A_touch)
+    of the corner's touches (P1, P2 travel +Y, P3 +X) with the edge normals turned by ``rot``."""
+    n1, n2 = rot @ np.array([0.0, 1.0]), rot @ np.array([1.0, 0.0])
+    travel = {"Y+": np.array([0.0, 1.0]), "X+": np.array([1.0, 0.0])}
+    row = {"X+": 2, "Y+": 4}
+    a_cal = np.zeros((3, jac.shape[1]))
+    a_touch = np.zeros((3, 3))
+    for i, (normal, key) in enumerate(((n1, "Y+"), (n1, "Y+"), (n2, "X+"))):
+        cos_t = float(normal @ travel[key])
+        a_cal[i] = normal @ jac[0:2] + cos_t * jac[row[key]]
+        a_touch[i, i] = cos_t
+    return a_cal, a_touch
+
+
+def _corner_map(t1c: float, t2c: float, u3c: float, rot: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """ξ -> (δX, δY, δθ) as (B, M): M gives (δa', δo', δθ) from ξ, B turns (δa', δo') by ``rot``."""
+    length = t2c - t1c
+    m = np.array([[-u3c / length, u3c / length, 1.0],
+                  [t2c / length, -t1c / length, 0.0],
+                  [-1.0 / length, 1.0 / length, 0.0]])
+    big = np.zeros((3, 3))
+    big[:2, :2] = rot
+    big[2, 2] = 1.0
+    return big, m
+
+
 def setup_noise_bound(sigma: float, *, t1: float = 30.0, t2: float = 150.0, u3: float = 40.0,
                       rotation_deg: float = 0.0, standoff: float = 0.0, estimator: str = "ls",
                       length_calibration: float = 1.0) -> dict[str, Any]:
@@ -1094,23 +1121,8 @@ def setup_noise_bound(sigma: float, *, t1: float = 30.0, t2: float = 150.0, u3: 
         raise ValueError("P1 and P2 must differ (t1 != t2)")
     jac = calibration_jacobian(estimator)["matrix"]          # (6, 12): skew X/Y, ρ X+ X− Y+ Y−
     rot = np.array([[np.cos(g), -np.sin(g)], [np.sin(g), np.cos(g)]])
-    n1, n2 = rot @ np.array([0.0, 1.0]), rot @ np.array([1.0, 0.0])
-    travel = {"Y+": np.array([0.0, 1.0]), "X+": np.array([1.0, 0.0])}
-    row = {"X+": 2, "Y+": 4}
-    # ξ = A_cal·ν_cal + A_touch·ν_touch over (12 calibration touches, P1, P2, P3)
-    a_cal = np.zeros((3, jac.shape[1]))
-    a_touch = np.zeros((3, 3))
-    for i, (normal, key) in enumerate(((n1, "Y+"), (n1, "Y+"), (n2, "X+"))):
-        cos_t = float(normal @ travel[key])
-        a_cal[i] = normal @ jac[0:2] + cos_t * jac[row[key]]
-        a_touch[i, i] = cos_t
-    # (δa', δo', δθ) from ξ
-    m = np.array([[-u3c / length, u3c / length, 1.0],
-                  [t2c / length, -t1c / length, 0.0],
-                  [-1.0 / length, 1.0 / length, 0.0]])
-    big = np.zeros((3, 3))
-    big[:2, :2] = rot
-    big[2, 2] = 1.0
+    a_cal, a_touch = _corner_sensitivities(jac, rot)
+    big, m = _corner_map(t1c, t2c, u3c, rot)
     cov_cal = big @ m @ (a_cal @ a_cal.T) @ m.T @ big.T
     cov_touch = big @ m @ (a_touch @ a_touch.T) @ m.T @ big.T
     cov = sigma * sigma * (cov_cal + cov_touch)
