@@ -435,12 +435,38 @@ def cycle998(call: Call) -> None:
         p2 = p1 + distance * e_k
         cone = 0.0
     target = call.zo_target(setup)
-    d = sigma * e_m
+    planner = _planner998(sigma * e_m, cone, fa)
+    feed = _position_feed(env)
+
+    def before_point(n):
+        if n == 2:
+            call.move(p2, feed)
+
+    params = {"axis": axis_m, "direction": "+" if sigma > 0 else "-", "reference_axis": axis_k,
+              "angle_correction": correction, "setpoint_angle": sta1, "measurements": call.measurements()}
+    spec = with_planner(with_finisher(TASKS["edge.align"], _within_safe_area998(sta1, tsa)), planner)
+    answer = call.run(env, spec, params, target, before_point=before_point)
+    call.move(p1, feed)
+    angle = float(answer["result"]["angle"])
+    written = target != "measure_only"
+    call.ovr.update({0: sta1, 4: angle, 16: angle_wrap(angle - sta1),
+                     20: angle_wrap(angle - sta1) if written else 0.0, 28: tsa})
+    call.ovi[11] = 1 if written else 0
+
+
+def _planner998(d, cone: float, fa: float):
+    """Edge probings along ``d``; P2's path covers the cone ±_TSA (``cone`` beyond _FA)."""
 
     def planner(params, n, s, ctx, label):
         if n == 2 and cone > 0.0:
             ctx = dataclasses.replace(ctx, measuring_path=fa + cone)
         return edge_program(d, s, ctx, label)
+
+    return planner
+
+
+def _within_safe_area998(sta1: float, tsa: float):
+    """The finisher's wrapper: an angle further than _TSA from the setpoint _STA1 corrects nothing."""
 
     def check(original):
         def finish(session, ctx, points):
@@ -452,22 +478,7 @@ def cycle998(call: Call) -> None:
             return answer, commit
         return finish
 
-    feed = _position_feed(env)
-
-    def before_point(n):
-        if n == 2:
-            call.move(p2, feed)
-
-    params = {"axis": axis_m, "direction": "+" if sigma > 0 else "-", "reference_axis": axis_k,
-              "angle_correction": correction, "setpoint_angle": sta1, "measurements": call.measurements()}
-    spec = with_planner(with_finisher(TASKS["edge.align"], check), planner)
-    answer = call.run(env, spec, params, target, before_point=before_point)
-    call.move(p1, feed)
-    angle = float(answer["result"]["angle"])
-    written = target != "measure_only"
-    call.ovr.update({0: sta1, 4: angle, 16: angle_wrap(angle - sta1),
-                     20: angle_wrap(angle - sta1) if written else 0.0, 28: tsa})
-    call.ovi[11] = 1 if written else 0
+    return check
 
 
 # --- CYCLE961 (measuring-math §12) ---------------------------------------------------------------------
