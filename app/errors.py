@@ -6,11 +6,13 @@ Services raise :class:`HmiError` subclasses; routers never build error responses
 from __future__ import annotations
 
 import logging
+from collections.abc import Awaitable, Callable
 
 from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
+from starlette.responses import Response
 
 from app.machine.protocol import MachineAlarm, MachineBusy
 from db import StorageUnavailable
@@ -128,65 +130,82 @@ def allowed_methods(request: Request) -> list[str]:
     return sorted(methods, key=lambda m: (order.index(m) if m in order else len(order), m))
 
 
+async def _hmi_error(_: Request, exc: HmiError):
+    response = error_response(exc.status, exc.code, exc.message, exc.field)
+    if exc.extra:
+        body = envelope(exc.code, exc.message, exc.field)
+        body["error"].update({k: v for k, v in exc.extra.items() if k not in body["error"]})
+        response = JSONResponse(body, status_code=exc.status)
+    response.headers.update(exc.headers)
+    return response
+
+
+async def _measuring_error(_: Request, exc: MeasuringError):
+    return error_response(409, "alarm", f"{exc.alarm} {exc.message}")
+
+
+async def _machine_alarm(_: Request, exc: MachineAlarm):
+    return error_response(409, "alarm", f"{exc.alarm.code} {exc.alarm.text}")
+
+
+async def _machine_busy(_: Request, exc: MachineBusy):
+    return error_response(409, "busy", str(exc) or "a motion is running")
+
+
+async def _request_validation(_: Request, exc: RequestValidationError):
+    errors = exc.errors()
+    first = errors[0] if errors else {}
+    field = field_path(first.get("loc", ())) or None
+    message = _validation_message(first) if first else "invalid request"
+    if field:
+        message = f"{field}: {message}"
+    return error_response(422, "validation", message, field)
+
+
+async def _http_error(request: Request, exc: StarletteHTTPException):
+    code = {404: "not_found", 405: "method_not_allowed"}.get(exc.status_code, "http_error")
+    response = error_response(exc.status_code, code, str(exc.detail))
+    response.headers.update(exc.headers or {})
+    if exc.status_code == 405:
+        # every method the path has (RFC 9110 §15.5.6): Starlette names only the first route's,
+        # FastAPI has one route per method
+        allowed = allowed_methods(request)
+        if allowed:
+            response.headers["Allow"] = ", ".join(allowed)
+    return response
+
+
+async def _storage(_: Request, exc: StorageUnavailable):
+    log.error("storage unavailable: %s", exc)
+    return error_response(503, "storage_unavailable", f"Nothing was stored: {exc}")
+
+
+async def _overflow(_: Request, exc: OverflowError):
+    # the safety net of app.checks: a number too large for a float that a check missed
+    log.warning("unchecked number overflow: %s", exc)
+    return error_response(422, "validation", "a number is too large")
+
+
+async def _value_error(_: Request, exc: ValueError):
+    # A ValueError escaping a service is bad input the service did not name (e.g. numpy/engine).
+    log.info("unclassified ValueError: %s", exc)
+    return error_response(422, "validation", str(exc))
+
+
+_HANDLERS: tuple[tuple[type[Exception], Callable[..., Awaitable[Response]]], ...] = (
+    (HmiError, _hmi_error),
+    (MeasuringError, _measuring_error),
+    (MachineAlarm, _machine_alarm),
+    (MachineBusy, _machine_busy),
+    (RequestValidationError, _request_validation),
+    (StarletteHTTPException, _http_error),
+    (StorageUnavailable, _storage),
+    (OverflowError, _overflow),
+    (ValueError, _value_error),
+)
+
+
 def install_handlers(app: FastAPI) -> None:
-    @app.exception_handler(HmiError)
-    async def _hmi_error(_: Request, exc: HmiError):
-        response = error_response(exc.status, exc.code, exc.message, exc.field)
-        if exc.extra:
-            body = envelope(exc.code, exc.message, exc.field)
-            body["error"].update({k: v for k, v in exc.extra.items() if k not in body["error"]})
-            response = JSONResponse(body, status_code=exc.status)
-        response.headers.update(exc.headers)
-        return response
-
-    @app.exception_handler(MeasuringError)
-    async def _measuring_error(_: Request, exc: MeasuringError):
-        return error_response(409, "alarm", f"{exc.alarm} {exc.message}")
-
-    @app.exception_handler(MachineAlarm)
-    async def _machine_alarm(_: Request, exc: MachineAlarm):
-        return error_response(409, "alarm", f"{exc.alarm.code} {exc.alarm.text}")
-
-    @app.exception_handler(MachineBusy)
-    async def _machine_busy(_: Request, exc: MachineBusy):
-        return error_response(409, "busy", str(exc) or "a motion is running")
-
-    @app.exception_handler(RequestValidationError)
-    async def _request_validation(_: Request, exc: RequestValidationError):
-        errors = exc.errors()
-        first = errors[0] if errors else {}
-        field = field_path(first.get("loc", ())) or None
-        message = _validation_message(first) if first else "invalid request"
-        if field:
-            message = f"{field}: {message}"
-        return error_response(422, "validation", message, field)
-
-    @app.exception_handler(StarletteHTTPException)
-    async def _http_error(request: Request, exc: StarletteHTTPException):
-        code = {404: "not_found", 405: "method_not_allowed"}.get(exc.status_code, "http_error")
-        response = error_response(exc.status_code, code, str(exc.detail))
-        response.headers.update(exc.headers or {})
-        if exc.status_code == 405:
-            # every method the path has (RFC 9110 §15.5.6): Starlette names only the first route's,
-            # FastAPI has one route per method
-            allowed = allowed_methods(request)
-            if allowed:
-                response.headers["Allow"] = ", ".join(allowed)
-        return response
-
-    @app.exception_handler(StorageUnavailable)
-    async def _storage(_: Request, exc: StorageUnavailable):
-        log.error("storage unavailable: %s", exc)
-        return error_response(503, "storage_unavailable", f"Nothing was stored: {exc}")
-
-    @app.exception_handler(OverflowError)
-    async def _overflow(_: Request, exc: OverflowError):
-        # the safety net of app.checks: a number too large for a float that a check missed
-        log.warning("unchecked number overflow: %s", exc)
-        return error_response(422, "validation", "a number is too large")
-
-    @app.exception_handler(ValueError)
-    async def _value_error(_: Request, exc: ValueError):
-        # A ValueError escaping a service is bad input the service did not name (e.g. numpy/engine).
-        log.info("unclassified ValueError: %s", exc)
-        return error_response(422, "validation", str(exc))
+    """The error envelope {"error": {"code", "message"}} (design.md §4) for the domain errors, bad input and HTTP errors."""
+    for exc_type, handler in _HANDLERS:
+        app.add_exception_handler(exc_type, handler)
