@@ -12,7 +12,7 @@ from asgi_csrf import asgi_csrf
 from fastapi import FastAPI
 from starlette.routing import Mount, Route
 
-from app import openapi_doc
+from app import openapi_doc, route_cache
 from app.access.deps import PUBLIC_ROUTES
 from app.access.handlers import install_access_handlers
 from app.access.middleware import (
@@ -168,6 +168,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.add_middleware(LanguageMiddleware)          # the screens' language (app/web/language.py)
     app.include_router(api_router)
     app.include_router(web_router)
+    route_cache.install()                           # the routes' matches kept per path (app/route_cache.py)
     app.mount("/static", VersionedStaticFiles(directory=STATIC_DIR), name="static")
     openapi_doc.install(app, public_paths={r.path for r in _flat_routes(app)
                                             if isinstance(r.route if hasattr(r, "original_route") else r, Route | Mount)
