@@ -37,6 +37,7 @@ estimator ``estimate_ring`` / ``calibrate_ring`` below (its own derivation; docs
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
@@ -797,6 +798,27 @@ def _ring_covariance(f: FloatArray, jac: FloatArray, t_mat: FloatArray, dof: int
     return s_used, cov
 
 
+def _ring_model(touches: tuple[RingTouch, ...], plane: Plane, frame: str, to_mcs: Callable[[FloatArray], FloatArray],
+                big_r: float) -> tuple[_RingDesign, FloatArray, _RingModel]:
+    """The design of the touches, their direction classes' angles and the least-squares model."""
+    design = _ring_design(touches, plane, frame, to_mcs)
+    class_angles, cls = _classes(design.theta)
+    return design, class_angles, _RingModel(design, cls, len(class_angles), big_r)
+
+
+def _ring_observability(frame: str, center: npt.ArrayLike | None, skew: npt.ArrayLike | None,
+                        constrained: bool) -> tuple[bool, bool]:
+    """(the centre is observable, the skew found is the effective one)."""
+    center_observable = not (frame == "machine" and center is None) or not constrained
+    skew_effective = frame == "probe" and skew is None and constrained
+    return center_observable, skew_effective
+
+
+def _spread(cov: FloatArray | None, c: FloatArray) -> float:
+    """The standard deviation of c·x (nan without a covariance)."""
+    return float("nan") if cov is None else float(np.sqrt(max(float(c @ cov @ c), 0.0)))
+
+
 def estimate_ring(touches: Sequence[RingTouch], diameter: float, probe: ProbeRecord, plane: Plane, *,
                   frame: str = "probe", center: npt.ArrayLike | None = None, skew: npt.ArrayLike | None = None,
                   wcs2bcs: Frame | None = None,
@@ -826,10 +848,8 @@ def estimate_ring(touches: Sequence[RingTouch], diameter: float, probe: ProbeRec
     if n < 4:
         raise MeasuringError(alarms.CIRCLE_PARAMETERS, f"a ring calibration needs 4 or more touches, got {n}")
     to_mcs: Callable[[FloatArray], FloatArray] = (lambda v: v) if wcs2bcs is None else wcs2bcs.dir_child2parent
-    design = _ring_design(touches, plane, frame, to_mcs)
-    class_angles, cls = _classes(design.theta)
+    design, class_angles, model = _ring_model(touches, plane, frame, to_mcs, big_r)
     m = len(class_angles)
-    model = _RingModel(design, cls, m, big_r)
     names = ("center_a", "center_o", "skew_X", "skew_Y", *[f"rho_{a:g}" for a in class_angles], "ball_radius")
 
     x_fixed = _ring_fixed(model.n_par, r_nom, plane, center, skew)
@@ -846,14 +866,11 @@ def estimate_ring(touches: Sequence[RingTouch], diameter: float, probe: ProbeRec
                             covariance=None if cov is None else cov[4:4 + m, 4:4 + m],
                             include_first=not constrained, axial_radius=axial)
 
-    def spread(c: FloatArray) -> float:
-        return float("nan") if cov is None else float(np.sqrt(max(float(c @ cov @ c), 0.0)))
-
+    spread = functools.partial(_spread, cov)
     trigger, trigger_std, surface_std = _key_triggers(lobing, rho, plane, to_mcs, spread, model.n_par)
     w0 = np.concatenate([np.zeros(4), lobing.weights_mean(), [0.0]])
     max_h = float(np.max(np.abs(model.chord_offsets(x))))
-    center_observable = not (frame == "machine" and center is None) or not constrained
-    skew_effective = frame == "probe" and skew is None and constrained
+    center_observable, skew_effective = _ring_observability(frame, center, skew, constrained)
     notes = _ring_notes(frame, first_harmonic, skew_effective, center_observable, constrained, max_h,
                         big_r - r_nom, radius_free, r_nom, r_hat)
     return RingEstimate(
