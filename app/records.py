@@ -112,6 +112,9 @@ class ProbeData(ProbeHealthFields):
     cal_wo: str | None = Field(None, max_length=12)              # WO the calibration was measured in
     # the lathe's _WP[k,7]/[8] (turning.md §0.7): true ball centre minus the NC's, {"Z", "X"}
     position_deviation: dict[Literal["Z", "X"], StrictFloat] | None = None
+    # the lathe's calibration status _WP[k,9]/[10] (turning.md §0.7): the directions a CYCLE973
+    # calibration (groove or surface, JOG or NC) measured the trigger value of; None: never
+    calibrated_directions: list[Literal["X-", "X+", "Z-", "Z+", "Y-", "Y+"]] | None = None
     # the direction-dependent trigger map of a ring calibration with more than 4 directions
     # (engine.lobing.LobingMap.values_json, design.md §9.8); None: the 4 trigger values only
     lobing: dict | None = None
@@ -223,6 +226,6 @@ class ToolData(BaseModel):
         return self.sl is not None or self.l1 is not None or self.l2 is not None
 
 
-LATHE_RECORD_KEYS = ("position_deviation", "workpiece_trigger")   # probe / tool probe records of a lathe
+LATHE_RECORD_KEYS = ("position_deviation", "workpiece_trigger", "calibrated_directions")   # probe / tool probe records of a lathe
 LATHE_PROBE_TYPE = 580      # the lathe's workpiece probe: a 5xy tool with SL 5..8 (turning.md §0.6)
 

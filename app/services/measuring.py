@@ -291,7 +291,7 @@ class MeasuringEnv:
         """A calibration written: a new calibration id (its probe_events row), valid again, the
         probe it was made with (design.md §10.4); the log entry carries the new id."""
         data = {k: record.get(k) for k in ("calibrated_at", "calibrated_length", "calibrated_radius",
-                                           "calibrated_diameter", "trigger", "effective_diameter",
+                                           "calibrated_diameter", "calibrated_directions", "trigger", "effective_diameter",
                                            "measured_ball_diameter") if k in record}
         event = unit.add_probe_event(probe, n, "calibration", {**data, "task": entry.get("task")})
         entry["calibration_id"] = event["id"]

@@ -25,6 +25,7 @@ NAMES = {
     "calibrated_radius": N_("calibrated (radius)"), "calibrated_length": N_("calibrated (length)"),
     "calibrated_diameter": N_("calibrated (diameter)"), "calibrated_plane": N_("calibrated in plane"),
     "calibrated_planes": N_("calibrated in planes"), "calibrated_spindle_angle": N_("spindle angle at calibration"),
+    "calibrated_directions": N_("calibrated directions"),
     "calibration_feed": N_("calibration feed"), "calibration_override": N_("calibration override"),
     "length_to_tip": N_("length to the ball's tip"), "valid": N_("calibration valid"),
     "invalid_reason": N_("why invalid"), "cal_ring_diameter": N_("calibration ring diameter"),

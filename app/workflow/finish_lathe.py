@@ -253,6 +253,8 @@ def finish_probe(session: MeasureSession, prep: LathePrep, point, ctx: Measuring
             "effective_diameter": float(record.effective_diameter),
             "position_deviation": {a: float(record.skew.get(a, 0.0)) for a in ("Z", "X")},
             "tool": int(tool["t"]) if tool.get("t") else stored.get("tool"), "calibrated_plane": "G18",
+            # the directions calibrated so far: the lathe tasks use their trigger values (probe_trust)
+            "calibrated_directions": sorted(set(stored.get("calibrated_directions") or ()) | set(r.trigger)),
             "calibrated_at": _now()}
     try:
         data = ProbeData.model_validate(data).model_dump(mode="json")

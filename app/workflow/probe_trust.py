@@ -120,7 +120,8 @@ def is_calibrated(record: Mapping[str, Any] | None, probe: str = "workpiece") ->
     data = record or {}
     if probe == "tool":
         return bool(data.get("calibrated_length") or data.get("calibrated_diameter"))
-    return bool(data.get("calibrated_length") or data.get("calibrated_radius"))
+    # a lathe's probe (turning.md §0.7): calibrated by CYCLE973 in the directions it measured
+    return bool(data.get("calibrated_length") or data.get("calibrated_radius") or data.get("calibrated_directions"))
 
 
 def validity(record: Mapping[str, Any] | None, max_age_h: float, probe: str = "workpiece",

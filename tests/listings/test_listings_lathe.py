@@ -234,6 +234,25 @@ def test_6_3_5_and_6_3_6_incremental_calibration_and_measurement(lathe):
 
 # --- CYCLE973 on a surface (§6.4.3) ---------------------------------------------------------------------
 
+def test_6_4_2_the_nc_calibration_makes_the_probe_record_valid(lathe):
+    """After the §6.4.2 listing's CYCLE973 calls, GET /api/probes/1 says valid (before: the rough,
+    typed record read "not_calibrated", and so did the calibrated one) and holds the true values
+    of the directions calibrated (the milling flags stay unset: no ring, no length calibration)."""
+    lathe.rough_probe_record()
+    typed = lathe.ok(lathe.c.get("/api/probes/1"))
+    assert (typed["valid"], typed["invalid_reason"]) == (False, "not_calibrated")
+    lathe.run(KALIBRIEREN_IN_NUT_20537, replace=GROOVE_START)
+    record = lathe.ok(lathe.c.get("/api/probes/1"))
+    assert record["valid"] is True and record["invalid_reason"] is None
+    assert record["calibrated_directions"] == ["X+", "X-", "Z-"]
+    assert record["calibrated_radius"] is False and record["calibrated_length"] is False
+    assert record["trigger"]["Z-"] == pytest.approx(R_TRUE, abs=NOISE)
+    assert record["trigger"]["X-"] == pytest.approx(R_TRUE - DL1, abs=NOISE)
+    assert record["trigger"]["X+"] == pytest.approx(-R_TRUE - DL1, abs=NOISE)
+    history = lathe.ok(lathe.c.get("/api/probes/1/history", params={"probe": "workpiece"}))
+    assert history[0]["event"] == "calibration" and history[0]["id"] == record["calibration_id"]
+
+
 def test_6_4_3_probe_calibrated_on_the_face(lathe):
     """§6.4.3 %_N_KALIBRIEREN_IN_Z_MPF (lines 20714–20727): DIAMON, CYCLE973 _MVAR=0 _SETVAL=−18
     _MA=1 _MD=1: the shaft's end face lies at G54 Z−18 (G54 Z = FACE_Z + 18): _WP Z− is the
