@@ -798,12 +798,23 @@ def _ring_covariance(f: FloatArray, jac: FloatArray, t_mat: FloatArray, dof: int
     return s_used, cov
 
 
-def _ring_model(touches: tuple[RingTouch, ...], plane: Plane, frame: str, to_mcs: Callable[[FloatArray], FloatArray],
-                big_r: float) -> tuple[_RingDesign, FloatArray, _RingModel]:
-    """The design of the touches, their direction classes' angles and the least-squares model."""
+def _ring_touches(touches: Sequence[RingTouch]) -> tuple[RingTouch, ...]:
+    """The touches, 4 or more (CIRCLE_PARAMETERS)."""
+    touches = tuple(touches)
+    if len(touches) < 4:
+        raise MeasuringError(alarms.CIRCLE_PARAMETERS,
+                             f"a ring calibration needs 4 or more touches, got {len(touches)}")
+    return touches
+
+
+def _ring_model(touches: tuple[RingTouch, ...], plane: Plane, frame: str, wcs2bcs: Frame | None, big_r: float
+                ) -> tuple[Callable[[FloatArray], FloatArray], _RingDesign, FloatArray, _RingModel]:
+    """The direction map WCS -> MCS, the design of the touches, their direction classes' angles
+    and the least-squares model."""
+    to_mcs: Callable[[FloatArray], FloatArray] = (lambda v: v) if wcs2bcs is None else wcs2bcs.dir_child2parent
     design = _ring_design(touches, plane, frame, to_mcs)
     class_angles, cls = _classes(design.theta)
-    return design, class_angles, _RingModel(design, cls, len(class_angles), big_r)
+    return to_mcs, design, class_angles, _RingModel(design, cls, len(class_angles), big_r)
 
 
 def _ring_observability(frame: str, center: npt.ArrayLike | None, skew: npt.ArrayLike | None,
@@ -843,12 +854,9 @@ def estimate_ring(touches: Sequence[RingTouch], diameter: float, probe: ProbeRec
     skew inseparable, CIRCLE_UNDETERMINED for any other rank defect (e.g. directions on one axis).
     """
     big_r, r_nom = _ring_input(diameter, probe, frame, first_harmonic, ball)
-    touches = tuple(touches)
+    touches = _ring_touches(touches)
     n = len(touches)
-    if n < 4:
-        raise MeasuringError(alarms.CIRCLE_PARAMETERS, f"a ring calibration needs 4 or more touches, got {n}")
-    to_mcs: Callable[[FloatArray], FloatArray] = (lambda v: v) if wcs2bcs is None else wcs2bcs.dir_child2parent
-    design, class_angles, model = _ring_model(touches, plane, frame, to_mcs, big_r)
+    to_mcs, design, class_angles, model = _ring_model(touches, plane, frame, wcs2bcs, big_r)
     m = len(class_angles)
     names = ("center_a", "center_o", "skew_X", "skew_Y", *[f"rho_{a:g}" for a in class_angles], "ball_radius")
 
@@ -868,7 +876,6 @@ def estimate_ring(touches: Sequence[RingTouch], diameter: float, probe: ProbeRec
 
     spread = functools.partial(_spread, cov)
     trigger, trigger_std, surface_std = _key_triggers(lobing, rho, plane, to_mcs, spread, model.n_par)
-    w0 = np.concatenate([np.zeros(4), lobing.weights_mean(), [0.0]])
     max_h = float(np.max(np.abs(model.chord_offsets(x))))
     center_observable, skew_effective = _ring_observability(frame, center, skew, constrained)
     notes = _ring_notes(frame, first_harmonic, skew_effective, center_observable, constrained, max_h,
@@ -878,7 +885,7 @@ def estimate_ring(touches: Sequence[RingTouch], diameter: float, probe: ProbeRec
         center_observable=center_observable, skew=e.copy(), skew_effective=skew_effective,
         angles=class_angles, radii=rho.copy(), lobing=lobing, trigger=trigger, trigger_std=trigger_std,
         surface_std=surface_std, effective_diameter=2.0 * lobing.mean_radius,
-        effective_diameter_std=2.0 * spread(w0),
+        effective_diameter_std=2.0 * spread(np.concatenate([np.zeros(4), lobing.weights_mean(), [0.0]])),
         residuals=f, form_error=float(f.max() - f.min()), n=n, dof=dof, sigma=s_used, covariance=cov,
         param_names=names, max_chord_offset=max_h, notes=tuple(notes),
         ball_diameter=2.0 * r_hat, ball_diameter_estimated=radius_free,
