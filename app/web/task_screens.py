@@ -8,7 +8,6 @@ decide the probing are locked; setpoints and the target stay editable until Calc
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
 from typing import Literal, TypedDict
 
@@ -633,10 +632,7 @@ def _nc_start(env: _Env, page: TaskPage, form: dict):
     require_measurement(env.request, session.task, session.target)    # 403 shown on the screen
     env.workflow.start(session.id, wait=False)
     n = (session.progress or {}).get("point", 1)
-    deadline = time.monotonic() + NC_ANSWER_WAIT_S
-    while session.running and time.monotonic() < deadline:
-        time.sleep(0.005)
-    if session.running:
+    if not env.workflow.wait_ended(session, NC_ANSWER_WAIT_S):      # woken when it ends
         return {}, f"NC Start: measuring P{n}"
     message, level = _outcome(session, n)
     if level == "error":

@@ -50,6 +50,7 @@ class WorkflowService:
         self._env = env
         self._tasks = tasks
         self._lock = threading.Lock()
+        self._ended = threading.Condition()     # a background NC Start ended (wait_ended)
         self._session: MeasureSession | None = None
         self._reset = threading.Event()        # Reset: the running measurement starts no further step
         self._runner: threading.Thread | None = None
@@ -304,10 +305,18 @@ class WorkflowService:
             finally:
                 session.running = False
                 self._lock.release()
+                with self._ended:
+                    self._ended.notify_all()
 
         context = contextvars.copy_context()        # who pressed NC Start acts in the thread too (audit)
         threading.Thread(target=context.run, args=(background,), name=f"nc-start-{session.id}", daemon=True).start()
         return {"session": session.to_api(), "accepted": True}
+
+    def wait_ended(self, session: MeasureSession, timeout_s: float) -> bool:
+        """Wait up to ``timeout_s`` for a background NC Start of ``session`` to end (woken when it
+        does, no polling); True when it is not running."""
+        with self._ended:
+            return self._ended.wait_for(lambda: not session.running, timeout_s)
 
     def _prepare_start(self, session: MeasureSession, point: int | None):
         """Every refusal of NC Start before anything moves; marks the session running."""
