@@ -3,6 +3,8 @@ as input screens whose fields are the manual's parameters, the text the editor i
 parameter assignments and the call, SW 6.3 style: parameters set before the call, manual §2.2),
 and the way back from such a text to the form. ``read(render(c, p)) == (c, p)`` exactly:
 integers stay integers, reals are written with Python's shortest round-trip representation.
+The milling machine offers ``CYCLES``; a lathe offers ``LATHE_CYCLES`` (CYCLE982/973/974/994 with
+the parameters app.nc.cycles.lathe reads), and neither offers the other's.
 
     fields = CYCLES["CYCLE977"]                 # the form: parameter name, operator text, kind
     text = render("CYCLE977", {"_MVAR": 101, "_SETVAL": 20.0, "_KNUM": 1})
@@ -87,6 +89,40 @@ CYCLES: dict[str, tuple[CycleField, ...]] = {
 }
 
 
+# --- the lathe's cycles (manual ch. 6): the parameters app.nc.cycles.lathe reads -------------------
+_MD = _int("_MD", N_("Measuring direction (0 +, 1 −)"), 1, 0, 1)
+_AXIS_ZX = _int("_MA", N_("Measuring axis (1 Z, 2 X)"), 1, 1, 2)
+_AXIS_ZXY = _int("_MA", N_("Measuring axis (1 Z, 2 X, 3 Y)"), 2, 1, 3)
+_GEOMETRY = _int("_CHBIT[6]", N_("Correct the geometry (1) or the wear (0)"), 0, 0, 1)
+_KEEP_MEAN = _int("_CHBIT[4]", N_("Keep the mean value over the parts"), 0, 0, 1)
+
+LATHE_CYCLES: dict[str, tuple[CycleField, ...]] = {
+    "CYCLE982": (_VARIANT, _AXIS_ZX, _MD, _real("_STA1", N_("Starting angle")),
+                 _real("_CORA", N_("Correction angle position (second edge, reversal)")),
+                 _int("_CHBIT[3]", N_("Correct the wear (1) or the geometry (0)"), 0, 0, 1),
+                 _int("_PRNUM", N_("Tool probe number"), 1, 1, 3), *_COMMON[1:],
+                 _real("_TZL", N_("Zero offset range"), 0.0, 0.0, 1e5),
+                 _real("_TDIF", N_("Dimension difference"), 0.0, 0.0, 1e5),
+                 _int("_EVNUM", N_("Empirical value memory"), 0)),
+    "CYCLE973": (_int("_MVAR", N_("Measuring variant"), 0, 0, 99999), _AXIS_ZXY, _MD, _SETVAL,
+                 _int("_CALNUM", N_("Reference groove"), 1, 1, 3), *_COMMON,
+                 _real("_TZL", N_("Zero offset range"), 0.0, 0.0, 1e5)),
+    "CYCLE974": (_int("_MVAR", N_("Measuring variant"), 0, 0, 1000), _SETVAL, _AXIS_ZXY,
+                 _real("_STA1", N_("Start angle of the reversal")), _KNUM, _GEOMETRY, _KEEP_MEAN,
+                 *_COMMON, *_TOOL_OFFSET),
+    "CYCLE994": (_int("_MVAR", N_("Measuring variant"), 2, 1, 2), _SETVAL, _AXIS_ZXY,
+                 _real("_SZA", N_("Protection zone in Z (detour)")), _real("_SZO", N_("Protection zone in X")),
+                 _KNUM, _GEOMETRY, _KEEP_MEAN,
+                 _int("_CHBIT[7]", N_("Use the ball diameter (probe not calibrated)"), 0, 0, 1),
+                 *_COMMON, *_TOOL_OFFSET),
+}
+
+
+def cycles_for(lathe: bool) -> dict[str, tuple[CycleField, ...]]:
+    """The cycles the editor offers on this machine: the lathe's on a lathe, else the milling ones."""
+    return LATHE_CYCLES if lathe else CYCLES
+
+
 class CycleFormError(ValueError):
     """Bad input to the cycle support, naming the field (``cycle``, ``params.<name>``, ``text``)."""
 
@@ -96,11 +132,15 @@ class CycleFormError(ValueError):
         self.message = message
 
 
-def fields_of(cycle: str) -> dict[str, CycleField]:
-    if cycle not in CYCLES:
+def fields_of(cycle: str, lathe: bool = False) -> dict[str, CycleField]:
+    offered = cycles_for(lathe)
+    if cycle not in offered:
+        other = CYCLES if lathe else LATHE_CYCLES
+        why = (f" ({cycle} is a {'milling' if lathe else 'lathe'} cycle: this machine is a "
+               f"{'lathe' if lathe else 'milling machine'})" if cycle in other else "")
         raise CycleFormError("cycle", f"{cycle!r} is not a measuring cycle of the editor's cycle support "
-                             f"({', '.join(CYCLES)})")
-    return {f.name: f for f in CYCLES[cycle]}
+                             f"({', '.join(offered)}){why}")
+    return {f.name: f for f in offered[cycle]}
 
 
 def _value(field: CycleField, value: object) -> int | float:
@@ -122,9 +162,10 @@ def _text_of(value: int | float) -> str:
     return str(value) if isinstance(value, int) else repr(float(value))
 
 
-def render(cycle: str, params: dict) -> str:
-    """The assignments in the form's order and the call: ``_MVAR=101 _SETVAL=20.0\\nCYCLE977``."""
-    fields = fields_of(cycle)
+def render(cycle: str, params: dict, lathe: bool = False) -> str:
+    """The assignments in the form's order and the call: ``_MVAR=101 _SETVAL=20.0\\nCYCLE977``
+    (``lathe``: the machine is a lathe, its cycles are the ones offered)."""
+    fields = fields_of(cycle, lathe)
     if not isinstance(params, dict):
         raise CycleFormError("params", "params must be an object of the cycle's parameters")
     unknown = [k for k in params if k not in fields]
@@ -154,9 +195,11 @@ def _constant(expr) -> int | float | None:
     return None
 
 
-def read(text: str) -> tuple[str, dict]:
+def read(text: str, lathe: bool = False) -> tuple[str, dict]:
     """The last measuring-cycle call of ``text`` and the constant values its parameters were given
-    before it (what the editor's form shows when the operator opens the call)."""
+    before it (what the editor's form shows when the operator opens the call); ``lathe``: the
+    lathe's cycles are the ones read."""
+    offered = cycles_for(lathe)
     if not isinstance(text, str):
         raise CycleFormError("text", "text must be the program text")
     try:
@@ -176,9 +219,9 @@ def read(text: str) -> tuple[str, dict]:
                 value = _constant(word.values[0])
                 if value is not None:
                     seen[name] = value
-            elif isinstance(word, n.CycleCall) and word.name.upper() in CYCLES:
-                fields = fields_of(word.name.upper())
+            elif isinstance(word, n.CycleCall) and word.name.upper() in offered:
+                fields = fields_of(word.name.upper(), lathe)
                 found = (word.name.upper(), {k: _value(fields[k], v) for k, v in seen.items() if k in fields})
     if found is None:
-        raise CycleFormError("text", f"the text calls no measuring cycle of the cycle support ({', '.join(CYCLES)})")
+        raise CycleFormError("text", f"the text calls no measuring cycle of the cycle support ({', '.join(offered)})")
     return found

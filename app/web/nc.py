@@ -144,9 +144,14 @@ def mda_single_block(request: Request, nc: NcDep, single_block: Annotated[str | 
 
 # --- the program manager -----------------------------------------------------------------------------
 
+def _lathe(request: Request) -> bool:
+    return bool(request.app.state.services.machine.is_lathe)
+
+
 def _programs(request: Request, programs, nc, extra: dict | None = None, status_code: int = 200):
+    cycle_names = list(cycle_forms.cycles_for(_lathe(request)))
     return render_screen(request, "programs.html", {"screen": "programs", "programs": programs.list(),
-                                                    "selected": nc.status()["program"], "cycle_names": list(cycle_forms.CYCLES),
+                                                    "selected": nc.status()["program"], "cycle_names": cycle_names,
                                                     "cycle": None, "cycle_fields": None, "cycle_values": {}, "cursor": None,
                                                     **(extra or {})},
                          status_code=status_code)
@@ -172,7 +177,9 @@ async def programs_cycle(request: Request, name: str, programs: ProgramsDep, nc:
     "read" fills the screen from the last call up to the cursor's line. Nothing is saved."""
     form = await request.form()
     text, action = str(form.get("text", "")), str(form.get("action", "form"))
-    cycle = str(form.get("cycle", "CYCLE977"))
+    lathe = _lathe(request)
+    offered = cycle_forms.cycles_for(lathe)
+    cycle = str(form.get("cycle", next(iter(offered))))
     try:
         cursor = int(str(form.get("cursor", len(text))) or len(text))
     except ValueError:
@@ -182,10 +189,10 @@ async def programs_cycle(request: Request, name: str, programs: ProgramsDep, nc:
     values: dict = {}
     error = None
     try:
-        fields = cycle_forms.fields_of(cycle)
+        fields = cycle_forms.fields_of(cycle, lathe)
         if action == "read":
-            cycle, values = cycle_forms.read(text[:end])
-            fields = cycle_forms.fields_of(cycle)
+            cycle, values = cycle_forms.read(text[:end], lathe)
+            fields = cycle_forms.fields_of(cycle, lathe)
         elif action == "insert":
             typed = {k[2:]: str(v).strip() for k, v in form.items() if k.startswith("p:") and str(v).strip()}
             try:
@@ -193,14 +200,14 @@ async def programs_cycle(request: Request, name: str, programs: ProgramsDep, nc:
             except ValueError:
                 values = typed
                 raise cycle_forms.CycleFormError("params", _("Enter numbers in the cycle's fields")) from None
-            block = cycle_forms.render(cycle, values) + "\n"
+            block = cycle_forms.render(cycle, values, lathe) + "\n"
             editing["text"] = text[:start] + block + text[start:]
             cursor = start + len(block)
     except cycle_forms.CycleFormError as exc:
         error = exc.message
     return _programs(request, programs, nc, {"editing": editing, "cycle": cycle, "cursor": cursor,
-                                             "cycle_fields": [f.to_api(_) for f in cycle_forms.CYCLES[cycle]]
-                                             if cycle in cycle_forms.CYCLES else None,
+                                             "cycle_fields": [f.to_api(_) for f in offered[cycle]]
+                                             if cycle in offered else None,
                                              "cycle_values": values, "cycle_error": error})
 
 

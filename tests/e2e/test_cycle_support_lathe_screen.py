@@ -1,0 +1,82 @@
+"""Cycle support of the program manager on the simulated lathe (issue 28 item 6, manual §7.2–7.3):
+the cycle choice offers the lathe's CYCLE982/973/974/994 only; the operator fills CYCLE974's input
+screen (the manual's parameter names beside the texts), inserts the call at the cursor, reads it
+back into the form, and a bad value is refused naming the parameter."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import httpx
+import pytest
+from live import browser_tab, serve
+from playwright.sync_api import expect
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "lathe"))
+from lathe_kit import LATHE_SCENARIO  # noqa: E402
+
+pytestmark = pytest.mark.e2e
+
+
+@pytest.fixture(scope="module")
+def lathe_server(tmp_path_factory):
+    with serve(tmp_path_factory.mktemp("lathe-cycles"), LATHE_SCENARIO) as url:
+        yield url
+
+
+@pytest.fixture
+def tab(browser, lathe_server):
+    with browser_tab(browser, lathe_server, timeout_ms=15000) as page:
+        yield page
+
+
+def test_lathe_cycle_inserted_at_the_cursor_and_read_back(tab, lathe_server):
+    with httpx.Client(base_url=lathe_server, timeout=30) as http:
+        assert http.get("/api/machine").json()["kind"] == "lathe"
+        http.delete("/api/programs/LATHECYC")
+        made = http.post("/api/programs", json={"name": "LATHECYC", "text": "N10 G54 G18 T8 D1 DIAMON\nN20 M30"})
+        assert made.status_code == 201, made.text
+    tab.goto("/programs")
+    tab.locator('tr[data-program="LATHECYC"]').get_by_role("button", name="Edit").click()
+    editor = tab.locator("#program-editor textarea")
+    expect(editor).to_have_value("N10 G54 G18 T8 D1 DIAMON\nN20 M30")
+    options = tab.locator("#cycle-choice option")
+    expect(options).to_have_text(["CYCLE982", "CYCLE973", "CYCLE974", "CYCLE994"])
+    editor.click()
+    tab.keyboard.press("Control+End")
+    tab.keyboard.press("Home")                                    # the cursor on line 2 (N20 M30)
+    tab.locator("#cycle-choice").select_option("CYCLE974")
+    tab.locator("#cycle-show").click()
+    fields = tab.locator("#cycle-fields")
+    expect(fields).to_have_attribute("data-cycle", "CYCLE974")
+    expect(fields).to_contain_text("_STA1")                       # the manual's names beside the texts
+    expect(fields).to_contain_text("Start angle of the reversal")
+    fields.locator('input[data-param="_MVAR"]').fill("1000")
+    fields.locator('input[data-param="_SETVAL"]').fill("45")
+    fields.locator('input[data-param="_MA"]').fill("2")
+    fields.locator('input[data-param="_FA"]').fill("2.5")
+    tab.locator("#cycle-insert").click()
+    expect(editor).to_have_value("N10 G54 G18 T8 D1 DIAMON\n_MVAR=1000 _SETVAL=45.0 _MA=2 _FA=2.5\nCYCLE974\nN20 M30")
+    # another input screen, then the call at the cursor (line 3) read back into the form
+    tab.locator("#cycle-choice").select_option("CYCLE994")
+    tab.locator("#cycle-show").click()
+    expect(tab.locator("#cycle-fields")).to_have_attribute("data-cycle", "CYCLE994")
+    editor.click()
+    tab.keyboard.press("Control+Home")
+    for _ in range(2):
+        tab.keyboard.press("ArrowDown")
+    tab.locator("#cycle-read").click()
+    fields = tab.locator("#cycle-fields")
+    expect(fields).to_have_attribute("data-cycle", "CYCLE974")
+    expect(fields.locator('input[data-param="_MVAR"]')).to_have_value("1000")
+    expect(fields.locator('input[data-param="_SETVAL"]')).to_have_value("45.0")
+    expect(fields.locator('input[data-param="_MA"]')).to_have_value("2")
+    expect(fields.locator('input[data-param="_FA"]')).to_have_value("2.5")
+    # a measuring axis the lathe has not: refused naming _MA, the program text unchanged
+    fields.locator('input[data-param="_MA"]').fill("4")
+    tab.locator("#cycle-insert").click()
+    expect(tab.locator("#cycle-error")).to_contain_text("_MA")
+    expect(editor).to_have_value("N10 G54 G18 T8 D1 DIAMON\n_MVAR=1000 _SETVAL=45.0 _MA=2 _FA=2.5\nCYCLE974\nN20 M30")
+    with httpx.Client(base_url=lathe_server, timeout=30) as http:
+        assert http.get("/api/programs/LATHECYC").json()["text"] == "N10 G54 G18 T8 D1 DIAMON\nN20 M30"
