@@ -203,6 +203,8 @@ def findings(spec, params: dict, n: int, ctx, machine, directions: list[np.ndarr
         return health_findings(ctx.extra.get("tool_probe"), ctx.settings, "tool")
     if spec.category == Category.TOOL_PROBE_CALIBRATION:
         return []
+    if spec.lathe:
+        return _lathe_findings(spec, params, ctx)
     if not spec.needs_probe or ctx.probe is None:
         return []
     if directions is None:
@@ -212,3 +214,15 @@ def findings(spec, params: dict, n: int, ctx, machine, directions: list[np.ndarr
     if spec.category != Category.PROBE_CALIBRATION:      # a calibration makes it valid again
         found += health_findings(ctx.probe_data, ctx.settings)
     return found
+
+
+def _lathe_findings(spec, params: dict, ctx) -> list[Finding]:
+    """A lathe measurement (CYCLE974/994): the health of the _WP record it uses (``params.probe``,
+    _PRNUM). A direction never calibrated is the cycle's own alarm (61341, engine.turning_workpiece);
+    a calibration (CYCLE973) makes the record valid again."""
+    if spec.category != Category.WORKPIECE:
+        return []
+    number = int(params.get("probe") or 1)
+    records = ((ctx.extra or {}).get("lathe") or {}).get("probes") or []
+    record = next((r for r in records if int(r.get("number", 0)) == number), None)
+    return health_findings(record, ctx.settings)

@@ -108,3 +108,28 @@ def test_a_measurement_before_the_calibration_is_refused_and_runs_after_it(lathe
     diameter = next(p for p in LATHE_SCENARIO["workpiece"]["profile"] if p["type"] == "cylinder")["diameter"]
     assert answer["result"]["actual"] == pytest.approx(diameter, abs=2e-6)
     assert answer["calibration"]["valid"] is True and answer["calibration"]["number"] == 1
+
+
+def test_a_measurement_with_an_invalidated_lathe_calibration_warns_or_is_refused(lathe):
+    """design.md §10.4 on the lathe: after a ball change the 1-point measurement warns 65121 (the
+    setting "warn") or is refused before anything moves (the setting "refuse"); a new CYCLE973
+    calibration makes it measure again without the warning."""
+    lathe.calibrate_probe_in_groove()
+    data = record(lathe)
+    kept = {k: v for k, v in data.items() if k not in ("valid", "invalid_reason", "calibration_age_h")}
+    lathe.ok(lathe.c.put("/api/probes/1", json={**kept, "ball_diameter": 5.0}))
+    params = {"axis": "X", "setpoint": 45, "measuring_path": 2}
+    lathe.ball_to(60.0, 30.0, coords="WCS")
+    warned = lathe.task("lathe.point", params)
+    assert any(w.startswith("65121") for w in warned["warnings"]), warned["warnings"]
+    lathe.ok(lathe.c.put("/api/settings", json={"calibration_invalid": "refuse"}))
+    lathe.ball_to(60.0, 30.0, coords="WCS")
+    where = lathe.status()["mcs"]
+    session = lathe.ok(lathe.c.post("/api/measure", json={"task": "lathe.point", "params": params}))
+    refused = lathe.c.post(f"/api/measure/{session['id']}/start", json={})
+    assert refused.status_code == 409 and refused.json()["error"]["code"] == "calibration_invalid", refused.text
+    assert lathe.status()["mcs"] == where
+    lathe.calibrate_probe_in_groove()
+    lathe.ball_to(60.0, 30.0, coords="WCS")
+    again = lathe.task("lathe.point", params)
+    assert not any(w.startswith("65121") for w in again["warnings"])
