@@ -1,0 +1,47 @@
+"""The header follows the machine although an answer of its own is still on its way.
+
+The header (and the position block, the JOG panes) is drawn again on each "hmi-state" event
+(static/live.js). A second event while the first refresh is still under way must win: htmx would
+queue it on the old element, the first answer replaces that element, and the queued refresh is
+dropped, so the header kept the offset of before (seen as "G500" after "G54 activated"). The
+elements take the newest refresh instead (hx-sync "this:replace")."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+from playwright.sync_api import Error, expect
+
+pytestmark = pytest.mark.e2e
+
+
+def test_the_header_shows_the_newest_offset_although_an_older_refresh_answers_late(page, api):
+    with page.expect_response("**/ui/header"):
+        page.goto("/jog")                               # the live feed's first event draws it again
+    expect(page.locator("#header-status")).not_to_have_class(re.compile(r"\bhtmx-request\b"))
+    expect(page.locator("#hdr-wo")).to_have_text("G500")
+    stale = api.get("/ui/header").text                  # the header as it is now, with G500
+    held = []
+
+    def hold_the_first(route):
+        if held:
+            route.continue_()
+        else:
+            held.append(route)                          # answered late, below
+
+    page.route("**/ui/header", hold_the_first)
+    page.evaluate("htmx.trigger(document.body, 'hmi-state')")
+    expect(page.locator("#header-status")).to_have_class(re.compile(r"\bhtmx-request\b"))   # held
+    assert api.post("/api/machine/activate", json={"offset": "G54"}).status_code == 200
+    # the change's event has come (it writes the position block's offset) and asked the header
+    # again while the first refresh is held; then the late answer comes, with the old G500
+    expect(page.locator("#position .pos-wo").first).to_have_text("G54")
+    assert len(held) == 1
+    try:
+        held[0].fulfill(status=200, body=stale, content_type="text/html")
+    except Error:                                       # aborted by the newer refresh: as it should
+        pass
+    expect(page.locator("#hdr-wo")).to_have_text("G54")
+    expect(page.locator("#header-status")).not_to_have_class(re.compile(r"\bhtmx-request\b"))
+    expect(page.locator("#hdr-wo")).to_have_text("G54")
