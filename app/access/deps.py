@@ -14,6 +14,8 @@ from fastapi import Depends, Request, Security
 from fastapi.security import APIKeyCookie, HTTPBearer
 
 from app.errors import WorkflowError
+from app.workflow.context import MEASURE_ONLY
+from app.workflow.tasks import Category
 
 from .errors import AccessDenied, Unauthenticated
 from .identity import INVALID, NOBODY, Identity
@@ -119,9 +121,6 @@ def _authenticated(request: Request) -> None:
 def measuring_function(category: str, target) -> str | None:
     """The function a measurement's write needs besides ``measure``: a zero offset (``offsets``),
     tool data (``tools``), probe calibration (``calibration``); None for measure only."""
-    from app.workflow.context import MEASURE_ONLY
-    from app.workflow.tasks import Category
-
     if isinstance(target, dict):                  # a tool offset as target (design.md §9.3)
         return "tools"
     if category in (Category.PROBE_CALIBRATION, Category.TOOL_PROBE_CALIBRATION):

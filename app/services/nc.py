@@ -32,7 +32,15 @@ from app import checks
 from app.errors import ConflictError, HmiError, InvalidInput, ModeError, NotFoundError, TooLarge
 from app.machine.lathe import LatheStatus
 from app.machine.protocol import MachineAlarm, MachineBusy
-from app.nc import Interpreter, NcRuntimeError, NcStateError, NcSyntaxError, VariableError, Variables
+from app.nc import (
+    CallbackBacking,
+    Interpreter,
+    NcRuntimeError,
+    NcStateError,
+    NcSyntaxError,
+    VariableError,
+    Variables,
+)
 from app.nc.cycles import measuring_cycles
 from app.nc.interpreter import CycleContext
 from app.nc.nodes import Assign
@@ -648,8 +656,6 @@ class NcService:
 def _memory_backing(db: Database, kind: str, may_write):
     """_EV[i] / _MV[i] = memory n = i + 1 of the database (the same memories JOG uses);
     ``may_write(name)`` raises when the program's starter may not write them."""
-    from app.nc import CallbackBacking
-
     def read(key):
         n = int(key) + 1
         if not 1 <= n <= MEMORY_COUNT:
