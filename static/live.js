@@ -102,10 +102,25 @@
   function sessionSignature(s) {
     return JSON.stringify([s.id, s.running, s.progress, s.alarm, s.points, s.notice, s.answer && s.answer.log_id]);
   }
+  var stateAsks = 0;                            // how often "hmi-state" asked the screen again
   function changed(previous, now, name) {      // the first event (after loading, after a reconnect) too:
-    if (previous !== now) htmx.trigger(document.body, name);     // what changed since the page was made
+    if (previous !== now) {                    // what changed since the page was made
+      if (name === "hmi-state") stateAsks++;
+      htmx.trigger(document.body, name);
+    }
     return now;
   }
+  // a newer state that asks while an element's refresh is still under way is queued by htmx on that
+  // element, and dropped with it when the older answer replaces it (outerHTML): the header kept an
+  // old offset. Such an answer asks again, for the state that came meanwhile.
+  document.body.addEventListener("htmx:beforeRequest", function (event) {
+    event.detail.elt.hmiStateAsks = stateAsks;
+  });
+  document.body.addEventListener("htmx:beforeSwap", function (event) {   // (the replaced one hears nothing after)
+    var elt = event.detail.elt || event.target;
+    if (elt.hmiStateAsks !== undefined && elt.hmiStateAsks < stateAsks)
+      setTimeout(function () { htmx.trigger(document.body, "hmi-state"); }, 0);     // once it is swapped
+  });
 
   // an answer the browser gave up on (htmx's timeout, a send error) drew nothing: the next event
   // asks again, since a state that no longer changes would never ask (e.g. a measurement's outcome)

@@ -3,8 +3,8 @@
 The header (and the position block, the JOG panes) is drawn again on each "hmi-state" event
 (static/live.js). A second event while the first refresh is still under way must win: htmx would
 queue it on the old element, the first answer replaces that element, and the queued refresh is
-dropped, so the header kept the offset of before (seen as "G500" after "G54 activated"). The
-elements take the newest refresh instead (hx-sync "this:replace")."""
+dropped, so the header kept the offset of before (seen as "G500" after "G54 activated"). Now an
+answer that comes after a newer state asks again (static/live.js)."""
 
 from __future__ import annotations
 
@@ -40,7 +40,7 @@ def test_the_header_shows_the_newest_offset_although_an_older_refresh_answers_la
     assert len(held) == 1
     try:
         held[0].fulfill(status=200, body=stale, content_type="text/html")
-    except Error:                                       # aborted by the newer refresh: as it should
+    except Error:                                       # the page has gone on without it
         pass
     expect(page.locator("#hdr-wo")).to_have_text("G54")
     expect(page.locator("#header-status")).not_to_have_class(re.compile(r"\bhtmx-request\b"))
