@@ -12,6 +12,7 @@ import httpx
 import pytest
 from live import browser_tab, serve
 from playwright.sync_api import expect
+from test_cycle_support_screen import insert_and_read_back
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "lathe"))
 from lathe_kit import LATHE_SCENARIO  # noqa: E402
@@ -52,27 +53,10 @@ def test_lathe_cycle_inserted_at_the_cursor_and_read_back(tab, lathe_server):
     expect(fields).to_have_attribute("data-cycle", "CYCLE974")
     expect(fields).to_contain_text("_STA1")                       # the manual's names beside the texts
     expect(fields).to_contain_text("Start angle of the reversal")
-    fields.locator('input[data-param="_MVAR"]').fill("1000")
-    fields.locator('input[data-param="_SETVAL"]').fill("45")
-    fields.locator('input[data-param="_MA"]').fill("2")
-    fields.locator('input[data-param="_FA"]').fill("2.5")
-    tab.locator("#cycle-insert").click()
-    expect(editor).to_have_value("N10 G54 G18 T8 D1 DIAMON\n_MVAR=1000 _SETVAL=45.0 _MA=2 _FA=2.5\nCYCLE974\nN20 M30")
-    # another input screen, then the call at the cursor (line 3) read back into the form
-    tab.locator("#cycle-choice").select_option("CYCLE994")
-    tab.locator("#cycle-show").click()
-    expect(tab.locator("#cycle-fields")).to_have_attribute("data-cycle", "CYCLE994")
-    editor.click()
-    tab.keyboard.press("Control+Home")
-    for _ in range(2):
-        tab.keyboard.press("ArrowDown")
-    tab.locator("#cycle-read").click()
-    fields = tab.locator("#cycle-fields")
-    expect(fields).to_have_attribute("data-cycle", "CYCLE974")
-    expect(fields.locator('input[data-param="_MVAR"]')).to_have_value("1000")
-    expect(fields.locator('input[data-param="_SETVAL"]')).to_have_value("45.0")
-    expect(fields.locator('input[data-param="_MA"]')).to_have_value("2")
-    expect(fields.locator('input[data-param="_FA"]')).to_have_value("2.5")
+    # inserted, then another input screen, and the call at the cursor read back into the form
+    fields = insert_and_read_back(tab, "CYCLE974", {"_MVAR": "1000", "_SETVAL": "45", "_MA": "2", "_FA": "2.5"},
+                                  "N10 G54 G18 T8 D1 DIAMON\n_MVAR=1000 _SETVAL=45.0 _MA=2 _FA=2.5\nCYCLE974\nN20 M30",
+                                  "CYCLE994", {"_MVAR": "1000", "_SETVAL": "45.0", "_MA": "2", "_FA": "2.5"})
     # a measuring axis the lathe has not: refused naming _MA, the program text unchanged
     fields.locator('input[data-param="_MA"]').fill("4")
     tab.locator("#cycle-insert").click()
