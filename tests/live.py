@@ -16,9 +16,10 @@ CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic"
                  "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 
 
-def wait_for_requests(page, held, count: int = 1, timeout_s: float = 5.0) -> None:
+def wait_for_requests(page, held, count: int = 1, timeout_s: float = MIN_WAIT_MS / 1000) -> None:
     """Until a route handler has held ``count`` requests (``held``: its list or dict). Waits with
-    the page's own timer, so that Playwright runs the route handlers meanwhile."""
+    the page's own timer, so that Playwright runs the route handlers meanwhile; the ceiling is a
+    Playwright wait's (5 s was too short beside a busy core: a page's first live event came later)."""
     for _ in range(int(timeout_s * 10)):
         if len(held) >= count:
             return
