@@ -151,30 +151,39 @@
     }
   }
 
-  // the tab's id (static/hmi.js): the server stops this tab's held jog when the feed drops
-  var tab = window.hmiTabId ? window.hmiTabId() : "";
-  var source = new EventSource(tab ? url + (url.indexOf("?") < 0 ? "?" : "&") + "tab=" + encodeURIComponent(tab) : url);
-  source.addEventListener("open", function () { seen(); });
-  source.addEventListener("machine", function (event) {
-    seen();
-    var state = JSON.parse(event.data);
-    showPositions(state);
-    showOffset(state);
-    followUnits(state);
-    showLock(state);
-    showProbes(state);
-    var sig = machineSignature(state);
-    machineSig = changed(machineSig, sig, "hmi-state");
-    if (sessionSig === null && lastSession !== null) sessionSig = changed(null, lastSession, "hmi-session");
-  });
-  source.addEventListener("session", function (event) {
-    seen();
-    lastSession = sessionSignature(JSON.parse(event.data));
-    sessionSig = changed(sessionSig, lastSession, "hmi-session");
-  });
-  source.addEventListener("error", function () {          // the link broke (the browser reconnects)
-    machineSig = sessionSig = lastSession = null;
-    if (source.readyState !== EventSource.OPEN) connection(false);
-  });
-  window.addEventListener("pagehide", function () { source.close(); });
+  // the feed opens once htmx has read the page (its DOMContentLoaded listener, registered in <head>,
+  // runs before this one): an event that came earlier asked elements nobody listened on yet, and a
+  // state that no longer changes would never ask again (the header stayed as the page was made).
+  // A deferred script runs before DOMContentLoaded, with the document "interactive" already.
+  if (document.readyState === "complete") listen();
+  else document.addEventListener("DOMContentLoaded", listen);
+
+  function listen() {
+    // the tab's id (static/hmi.js): the server stops this tab's held jog when the feed drops
+    var tab = window.hmiTabId ? window.hmiTabId() : "";
+    var source = new EventSource(tab ? url + (url.indexOf("?") < 0 ? "?" : "&") + "tab=" + encodeURIComponent(tab) : url);
+    source.addEventListener("open", function () { seen(); });
+    source.addEventListener("machine", function (event) {
+      seen();
+      var state = JSON.parse(event.data);
+      showPositions(state);
+      showOffset(state);
+      followUnits(state);
+      showLock(state);
+      showProbes(state);
+      var sig = machineSignature(state);
+      machineSig = changed(machineSig, sig, "hmi-state");
+      if (sessionSig === null && lastSession !== null) sessionSig = changed(null, lastSession, "hmi-session");
+    });
+    source.addEventListener("session", function (event) {
+      seen();
+      lastSession = sessionSignature(JSON.parse(event.data));
+      sessionSig = changed(sessionSig, lastSession, "hmi-session");
+    });
+    source.addEventListener("error", function () {          // the link broke (the browser reconnects)
+      machineSig = sessionSig = lastSession = null;
+      if (source.readyState !== EventSource.OPEN) connection(false);
+    });
+    window.addEventListener("pagehide", function () { source.close(); });
+  }
 })();

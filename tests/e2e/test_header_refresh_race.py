@@ -45,3 +45,21 @@ def test_the_header_shows_the_newest_offset_although_an_older_refresh_answers_la
     expect(page.locator("#hdr-wo")).to_have_text("G54")
     expect(page.locator("#header-status")).not_to_have_class(re.compile(r"\bhtmx-request\b"))
     expect(page.locator("#hdr-wo")).to_have_text("G54")
+
+
+def test_the_live_feed_opens_once_htmx_has_read_the_page(page):
+    """A live event before htmx has read the page asks elements that nobody listens on yet, and a
+    state that no longer changes never asks again: the header stayed as the page was made (the
+    first test above waited in vain for its refresh in CI). static/live.js opens the feed after."""
+    page.add_init_script("""
+        const Feed = window.EventSource;
+        window.EventSource = function (url, options) {
+            const header = document.getElementById("header-status");
+            window.feedOpenedOnReadPage = !!(header && header["htmx-internal-data"]
+                                              && header["htmx-internal-data"].initHash);
+            return new Feed(url, options);
+        };
+    """)
+    with page.expect_response("**/ui/header"):          # the first event draws the header again
+        page.goto("/jog")
+    assert page.evaluate("window.feedOpenedOnReadPage") is True
