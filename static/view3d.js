@@ -1,114 +1,120 @@
 // The machine view in 3D (three.js, vendored: static/VENDORED.md). An ES module: it imports only
 // files under /static and takes every URL from the page (data-scene-url, data-machine-url,
-// data-events-url). The scene (MCS, mm, Z up) comes from app/web/scene3d.py; the probe follows
+// data-events-url, data-kind). The scene (MCS, mm; a milling machine Z up here, a lathe in view3d_lathe.js)
+// comes from app/web/scene3d.py; the probe follows
 // GET /api/machine (or the server-sent events when the page names a stream). Drawn on demand only:
 // nothing is rendered while nothing changes (the panel PC's CPU is shared with the simulator).
-import * as THREE from './vendor/three-0.187.0/build/three.module.js';
+import {
+  THREE, COLOR, webglAvailable, v3, polyline, solidMaterial, cylinder, extruded, circlePoints, dispose, ringBody,
+} from './view3d_parts.js';
+import { LATHE } from './view3d_lathe.js';
 import { OrbitControls } from './vendor/three-0.187.0/examples/jsm/controls/OrbitControls.js';
 
-const COLOR = {
-  block: 0x8fa3b8, hole: 0x2b3640, spigot: 0x6f8aa6, pocket: 0x2b3640, boss: 0x6f8aa6, prism: 0x8fa3b8,
-  sphere: 0x9db0c4, ring: 0xc9a227, tool_probe: 0x7a5fa8, probe: 0xf39200, shank: 0x9aa3ab,
-  move: 0x35506b, probing: 0xd32f2f, contact: 0xd32f2f, touch: 0x2e7d32, measured: 0x0057b8,
-  table: 0xd7dde3, grid: 0xb5bec7, refused: 0xff00c8,
-};
 const PROBE_POLL_MS = 150;        // as the position display
 const SCENE_POLL_MS = 1000;
 const EVENT_FRESH_MS = 600;       // events newer than this replace the probe polling
 
-function webglAvailable() {
-  try {
-    const c = document.createElement('canvas');
-    return !!(c.getContext('webgl2') || c.getContext('webgl'));
-  } catch (e) {
-    return false;
-  }
-}
+// --- the milling machine (Z up, the tool along its axis) ---------------------------------------
+const MILL = {
+  up: [0, 0, 1],
+  view: [0.25, -0.85, 0.55],          // from the front (−Y), above
+  corners: (lim) => [[lim.X[0], lim.Y[0], lim.Z[0]], [lim.X[1], lim.Y[1], lim.Z[1]]],
+  // the NC's tool reference: axes − L·tool axis
+  ncTip(status) {
+    const axis = status.tool_axis || [0, 0, 1];
+    const length = Number(status.tool_length || 0);
+    return ['X', 'Y', 'Z'].map((a, i) => Number(status.mcs[a]) - length * axis[i]);
+  },
+  sceneStatus: (p) => ({ mcs: { X: p.tip[0], Y: p.tip[1], Z: p.tip[2] }, tool_length: 0, tool_axis: p.axis }),
+  probeText: (nc) => `X ${nc[0].toFixed(3)} · Y ${nc[1].toFixed(3)} · Z ${nc[2].toFixed(3)}`,
+  probeShape: (p) => [p.diameter, p.is_probe, p.tool_length],
+  orient(probe, status) {
+    probe.quaternion.setFromUnitVectors(new THREE.Vector3(0, 0, 1), v3(status.tool_axis || [0, 0, 1]).normalize());
+  },
 
-const v3 = (p) => new THREE.Vector3(p[0], p[1], p[2]);
+  buildProbe(p) {
+    const group = new THREE.Group();
+    const r = Math.max(p.diameter / 2, 0.5);
+    const length = Math.max(p.tool_length, 10);
+    if (p.is_probe) {
+      group.add(new THREE.Mesh(new THREE.SphereGeometry(r, 32, 16), solidMaterial(COLOR.probe)));
+      group.add(cylinder([0, 0, length], [0, 0, 1], Math.max(r * 0.35, 0.6), length - r, solidMaterial(COLOR.shank)));
+    } else {
+      group.add(cylinder([0, 0, Math.min(length, 60)], [0, 0, 1], r, Math.min(length, 60), solidMaterial(COLOR.probe)));
+      group.add(cylinder([0, 0, length], [0, 0, 1], Math.max(r, 6), Math.max(length - 60, 1), solidMaterial(COLOR.shank)));
+    }
+    group.add(cylinder([0, 0, length + 30], [0, 0, 1], 30, 30, solidMaterial(COLOR.shank, 0.5)));   // spindle nose
+    return group;
+  },
 
-function lineMaterial(color, dashed) {
-  return dashed ? new THREE.LineDashedMaterial({ color, dashSize: 4, gapSize: 3 })
-    : new THREE.LineBasicMaterial({ color });
-}
+  buildSolids(layers, data) {
+    const { solids } = data;
+    let part = 0;
+    const partMaterial = (kind) => solidMaterial(COLOR[kind] || COLOR.block, 0.55);
+    if (solids.block) {
+      const c = solids.block.corners;
+      layers.solids.add(extruded(c.slice(0, 4), c.slice(4, 8), partMaterial('block')));
+      part += 1;
+    }
+    if (solids.prism) {
+      layers.solids.add(extruded(solids.prism.top, solids.prism.bottom, partMaterial('prism')));
+      part += 1;
+    }
+    const rings = {};
+    (solids.circles || []).forEach((c) => {
+      const r = c.diameter / 2;
+      if (c.kind === 'ring_bore' || c.kind === 'ring_outer') {
+        rings[c.center.join(',')] = { ...(rings[c.center.join(',')] || {}), [c.kind]: c };
+      } else if (c.kind === 'tool_probe') {
+        layers.solids.add(cylinder(c.center, c.axis, r, c.height, solidMaterial(COLOR.tool_probe)));
+      } else {
+        layers.solids.add(cylinder(c.center, c.axis, r, c.height, partMaterial(c.kind), c.kind === 'hole'));
+        if (c.kind === 'hole') layers.solids.add(polyline(circlePoints(c.center, c.axis, r), COLOR.hole, { closed: true }));
+        part += 1;
+      }
+    });
+    Object.values(rings).forEach(({ ring_bore: bore, ring_outer: outer }) => {
+      const ring = outer || bore;
+      layers.solids.add(ringBody(ring.center, ring.axis, bore ? bore.diameter / 2 : 0, outer.diameter / 2, ring.height,
+        solidMaterial(COLOR.ring)));
+    });
+    (solids.rects || []).forEach((rect) => {
+      const pts = rect.corners.map(v3);
+      layers.solids.add(polyline(pts, COLOR[rect.kind] || COLOR.block, { closed: true }));
+      const geometry = new THREE.BufferGeometry().setFromPoints(pts);
+      geometry.setIndex([0, 1, 2, 0, 2, 3]);
+      geometry.computeVertexNormals();
+      layers.solids.add(new THREE.Mesh(geometry, partMaterial(rect.kind)));
+      part += 1;
+    });
+    (solids.spheres || []).forEach((s) => {
+      const mesh = new THREE.Mesh(new THREE.SphereGeometry(s.diameter / 2, 32, 16), partMaterial('sphere'));
+      mesh.position.copy(v3(s.center));
+      layers.solids.add(mesh);
+      part += 1;
+    });
+    this.buildTable(layers, data);
+    return part;
+  },
 
-function polyline(points, color, { dashed = false, closed = false } = {}) {
-  const geometry = new THREE.BufferGeometry().setFromPoints(points);
-  const line = closed ? new THREE.LineLoop(geometry, lineMaterial(color, dashed))
-    : new THREE.Line(geometry, lineMaterial(color, dashed));
-  if (dashed) line.computeLineDistances();
-  return line;
-}
+  buildTable(layers, data) {
+    const box = new THREE.Box3().setFromObject(layers.solids);
+    const lim = data.limits;
+    const z = box.isEmpty() ? lim.Z[0] : box.min.z - 0.5;
+    const sx = lim.X[1] - lim.X[0];
+    const sy = lim.Y[1] - lim.Y[0];
+    const size = Math.max(sx, sy);
+    const grid = new THREE.GridHelper(size, Math.round(size / 50), COLOR.grid, COLOR.grid);
+    grid.rotation.x = Math.PI / 2;
+    grid.position.set(lim.X[0] + size / 2, lim.Y[0] + size / 2, z);
+    layers.table.add(grid);
+    const table = new THREE.Mesh(new THREE.PlaneGeometry(sx, sy), solidMaterial(COLOR.table));
+    table.position.set(lim.X[0] + sx / 2, lim.Y[0] + sy / 2, z - 0.2);
+    layers.table.add(table);
+  },
+};
 
-function solidMaterial(color, opacity = 1) {
-  return new THREE.MeshStandardMaterial({
-    color, roughness: 0.7, metalness: 0.1, transparent: opacity < 1, opacity,
-    depthWrite: opacity >= 1, side: THREE.DoubleSide,
-  });
-}
-
-// a cylinder whose top face centre is `top`, standing along -axis for `height`
-function cylinder(top, axis, radius, height, material, open = false) {
-  const geometry = new THREE.CylinderGeometry(radius, radius, height, 48, 1, open);
-  const mesh = new THREE.Mesh(geometry, material);
-  const a = v3(axis).normalize();
-  mesh.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), a);
-  mesh.position.copy(v3(top).addScaledVector(a, -height / 2));
-  return mesh;
-}
-
-// a closed body from a top and a bottom ring of vertices (block corners, prism polygon)
-function extruded(top, bottom, material) {
-  const n = top.length;
-  const verts = [...top, ...bottom].map(v3);
-  const axis = new THREE.Vector3().subVectors(verts[0], verts[n]).normalize();
-  const u = new THREE.Vector3().subVectors(verts[1], verts[0]).normalize();
-  const w = new THREE.Vector3().crossVectors(axis, u);
-  const flat = top.map((p) => new THREE.Vector2(v3(p).dot(u), v3(p).dot(w)));
-  const caps = THREE.ShapeUtils.triangulateShape(flat, []);
-  const index = [];
-  caps.forEach(([a, b, c]) => { index.push(a, b, c, n + c, n + b, n + a); });
-  for (let i = 0; i < n; i += 1) {
-    const j = (i + 1) % n;
-    index.push(i, n + i, n + j, i, n + j, j);
-  }
-  const geometry = new THREE.BufferGeometry().setFromPoints(verts);
-  geometry.setIndex(index);
-  geometry.computeVertexNormals();
-  const group = new THREE.Group();
-  group.add(new THREE.Mesh(geometry, material));
-  const edges = [];
-  for (let i = 0; i < n; i += 1) {
-    const j = (i + 1) % n;
-    edges.push(verts[i], verts[j], verts[n + i], verts[n + j], verts[i], verts[n + i]);
-  }
-  group.add(new THREE.LineSegments(new THREE.BufferGeometry().setFromPoints(edges),
-    new THREE.LineBasicMaterial({ color: 0x33475b })));
-  return group;
-}
-
-function circlePoints(centre, normal, radius, segments = 64) {
-  const n = v3(normal).normalize();
-  const u = new THREE.Vector3(1, 0, 0);
-  if (Math.abs(n.dot(u)) > 0.9) u.set(0, 1, 0);
-  u.addScaledVector(n, -u.dot(n)).normalize();
-  const w = new THREE.Vector3().crossVectors(n, u);
-  const c = v3(centre);
-  const out = [];
-  for (let i = 0; i < segments; i += 1) {
-    const t = (2 * Math.PI * i) / segments;
-    out.push(c.clone().addScaledVector(u, radius * Math.cos(t)).addScaledVector(w, radius * Math.sin(t)));
-  }
-  return out;
-}
-
-function dispose(group) {
-  group.traverse((o) => {
-    if (o.geometry) o.geometry.dispose();
-    if (o.material) o.material.dispose();
-  });
-  group.clear();
-}
+const KINDS = { mill: MILL, lathe: LATHE };
 
 class View3D {
   constructor(el) {
@@ -128,8 +134,9 @@ class View3D {
     this.renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 2));
     this.scene = new THREE.Scene();
     this.scene.background = new THREE.Color(0xf4f6f8);
+    this.kind = KINDS[el.dataset.kind] || MILL;
     this.camera = new THREE.PerspectiveCamera(35, 1, 1, 50000);
-    this.camera.up.set(0, 0, 1);
+    this.camera.up.copy(v3(this.kind.up));
     this.controls = new OrbitControls(this.camera, this.canvas);
     this.controls.addEventListener('change', () => this.requestRender());
     this.scene.add(new THREE.HemisphereLight(0xffffff, 0x8090a0, 1.6));
@@ -231,39 +238,19 @@ class View3D {
   }
 
   showProbe(status) {
-    const axis = status.tool_axis || [0, 0, 1];
-    const length = Number(status.tool_length || 0);
-    const axes = ['X', 'Y', 'Z'].map((a) => Number(status.mcs[a]));
-    const nc = axes.map((v, i) => v - length * axis[i]);
+    const nc = this.kind.ncTip(status);
     const tip = nc.map((v, i) => v + this.probeOffset[i]);
     const key = tip.map((v) => v.toFixed(3)).join(' ');
     if (key === this.keys.probePos) return;
     this.keys.probePos = key;
     this.el.dataset.probe = nc.map((v) => v.toFixed(3)).join(' ');
     const out = this.out('probe');
-    if (out) out.textContent = `X ${nc[0].toFixed(3)} · Y ${nc[1].toFixed(3)} · Z ${nc[2].toFixed(3)}`;
+    if (out) out.textContent = this.kind.probeText(nc);
     if (this.probe) {
       this.probe.position.copy(v3(tip));
-      this.probe.quaternion.setFromUnitVectors(new THREE.Vector3(0, 0, 1), v3(axis).normalize());
+      this.kind.orient(this.probe, status);
       this.requestRender();
     }
-  }
-
-  buildProbe(p) {
-    dispose(this.layers.probe);
-    const group = new THREE.Group();
-    const r = Math.max(p.diameter / 2, 0.5);
-    const length = Math.max(p.tool_length, 10);
-    if (p.is_probe) {
-      group.add(new THREE.Mesh(new THREE.SphereGeometry(r, 32, 16), solidMaterial(COLOR.probe)));
-      group.add(cylinder([0, 0, length], [0, 0, 1], Math.max(r * 0.35, 0.6), length - r, solidMaterial(COLOR.shank)));
-    } else {
-      group.add(cylinder([0, 0, Math.min(length, 60)], [0, 0, 1], r, Math.min(length, 60), solidMaterial(COLOR.probe)));
-      group.add(cylinder([0, 0, length], [0, 0, 1], Math.max(r, 6), Math.max(length - 60, 1), solidMaterial(COLOR.shank)));
-    }
-    group.add(cylinder([0, 0, length + 30], [0, 0, 1], 30, 30, solidMaterial(COLOR.shank, 0.5)));   // spindle nose
-    this.probe = group;
-    this.layers.probe.add(group);
   }
 
   // --- the scene ----------------------------------------------------------------------------
@@ -276,95 +263,28 @@ class View3D {
       this.keys[name] = text;
       return true;
     };
-    if (changed('solids', [data.solids, data.limits])) this.buildSolids(data);
-    if (changed('probeShape', [data.probe.diameter, data.probe.is_probe, data.probe.tool_length])) {
-      this.buildProbe(data.probe);
+    if (changed('solids', [data.solids, data.limits])) {
+      dispose(this.layers.solids);
+      dispose(this.layers.table);
+      this.el.dataset.part = String(this.kind.buildSolids(this.layers, data));
+      if (this.kind.summary) Object.assign(this.el.dataset, this.kind.summary(data));
+    }
+    if (changed('probeShape', this.kind.probeShape(data.probe))) {
+      dispose(this.layers.probe);
+      this.probe = this.kind.buildProbe(data.probe);
+      this.layers.probe.add(this.probe);
       this.keys.probePos = '';
     }
     if (changed('wcs', data.wcs)) this.buildWcs(data.wcs);
     if (changed('plan', data.plan)) this.buildPlan(data.plan);
     if (changed('touches', [data.touches, data.probe.diameter])) this.buildTouches(data.touches, data.probe.diameter / 2);
     if (changed('measured', data.measured)) this.buildMeasured(data.measured);
-    this.showProbe({ mcs: { X: data.probe.tip[0], Y: data.probe.tip[1], Z: data.probe.tip[2] }, tool_length: 0, tool_axis: data.probe.axis });
+    this.showProbe(this.kind.sceneStatus(data.probe));
     if (!this.framed) this.frame(data);
     this.el.dataset.hidden = String(!!data.hidden);
+    this.el.dataset.sceneKind = data.kind || 'mill';
     this.el.dataset.state = 'ready';
     this.requestRender();
-  }
-
-  buildSolids(data) {
-    const { solids } = data;
-    dispose(this.layers.solids);
-    dispose(this.layers.table);
-    let part = 0;
-    const partMaterial = (kind) => solidMaterial(COLOR[kind] || COLOR.block, 0.55);
-    if (solids.block) {
-      const c = solids.block.corners;
-      this.layers.solids.add(extruded(c.slice(0, 4), c.slice(4, 8), partMaterial('block')));
-      part += 1;
-    }
-    if (solids.prism) {
-      this.layers.solids.add(extruded(solids.prism.top, solids.prism.bottom, partMaterial('prism')));
-      part += 1;
-    }
-    const rings = {};
-    (solids.circles || []).forEach((c) => {
-      const r = c.diameter / 2;
-      if (c.kind === 'ring_bore' || c.kind === 'ring_outer') {
-        rings[c.center.join(',')] = { ...(rings[c.center.join(',')] || {}), [c.kind]: c };
-      } else if (c.kind === 'tool_probe') {
-        this.layers.solids.add(cylinder(c.center, c.axis, r, c.height, solidMaterial(COLOR.tool_probe)));
-      } else {
-        this.layers.solids.add(cylinder(c.center, c.axis, r, c.height, partMaterial(c.kind), c.kind === 'hole'));
-        if (c.kind === 'hole') this.layers.solids.add(polyline(circlePoints(c.center, c.axis, r), COLOR.hole, { closed: true }));
-        part += 1;
-      }
-    });
-    Object.values(rings).forEach(({ ring_bore: bore, ring_outer: outer }) => {
-      const ring = outer || bore;
-      const material = solidMaterial(COLOR.ring);
-      this.layers.solids.add(cylinder(ring.center, ring.axis, outer.diameter / 2, ring.height, material, true));
-      if (bore) {
-        this.layers.solids.add(cylinder(ring.center, ring.axis, bore.diameter / 2, ring.height, material, true));
-        const top = new THREE.Mesh(new THREE.RingGeometry(bore.diameter / 2, outer.diameter / 2, 48), material);
-        top.quaternion.setFromUnitVectors(new THREE.Vector3(0, 0, 1), v3(ring.axis).normalize());
-        top.position.copy(v3(ring.center));
-        this.layers.solids.add(top);
-      }
-    });
-    (solids.rects || []).forEach((rect) => {
-      const pts = rect.corners.map(v3);
-      this.layers.solids.add(polyline(pts, COLOR[rect.kind] || COLOR.block, { closed: true }));
-      const geometry = new THREE.BufferGeometry().setFromPoints(pts);
-      geometry.setIndex([0, 1, 2, 0, 2, 3]);
-      geometry.computeVertexNormals();
-      this.layers.solids.add(new THREE.Mesh(geometry, partMaterial(rect.kind)));
-      part += 1;
-    });
-    (solids.spheres || []).forEach((s) => {
-      const mesh = new THREE.Mesh(new THREE.SphereGeometry(s.diameter / 2, 32, 16), partMaterial('sphere'));
-      mesh.position.copy(v3(s.center));
-      this.layers.solids.add(mesh);
-      part += 1;
-    });
-    this.el.dataset.part = String(part);
-    this.buildTable(data);
-  }
-
-  buildTable(data) {
-    const box = new THREE.Box3().setFromObject(this.layers.solids);
-    const lim = data.limits;
-    const z = box.isEmpty() ? lim.Z[0] : box.min.z - 0.5;
-    const sx = lim.X[1] - lim.X[0];
-    const sy = lim.Y[1] - lim.Y[0];
-    const size = Math.max(sx, sy);
-    const grid = new THREE.GridHelper(size, Math.round(size / 50), COLOR.grid, COLOR.grid);
-    grid.rotation.x = Math.PI / 2;
-    grid.position.set(lim.X[0] + size / 2, lim.Y[0] + size / 2, z);
-    this.layers.table.add(grid);
-    const table = new THREE.Mesh(new THREE.PlaneGeometry(sx, sy), solidMaterial(COLOR.table));
-    table.position.set(lim.X[0] + sx / 2, lim.Y[0] + sy / 2, z - 0.2);
-    this.layers.table.add(table);
   }
 
   buildWcs(wcs) {
@@ -444,15 +364,16 @@ class View3D {
     if (out) out.textContent = String(shapes.filter((s) => s.kind !== 'point').length);
   }
 
-  // the door's view: from the front (−Y), above, the solids and the probe in the picture
+  // the door's view (the kind's `view` direction), the solids and the probe in the picture
   frame(data) {
-    const box = new THREE.Box3().setFromObject(this.layers.solids);
+    const { focus } = this.layers.solids.userData;      // a kind's bodies to frame (else all)
+    const box = focus ? focus.clone() : new THREE.Box3().setFromObject(this.layers.solids);
     box.expandByPoint(v3(data.probe.tip));
-    if (box.isEmpty()) box.setFromPoints([v3([data.limits.X[0], data.limits.Y[0], data.limits.Z[0]]), v3([data.limits.X[1], data.limits.Y[1], data.limits.Z[1]])]);
+    if (box.isEmpty()) box.setFromPoints(this.kind.corners(data.limits).map(v3));
     const centre = box.getCenter(new THREE.Vector3());
     const radius = Math.max(box.getSize(new THREE.Vector3()).length() / 2, 50);
-    const distance = radius / Math.sin(THREE.MathUtils.degToRad(this.camera.fov / 2)) * 0.9;
-    this.camera.position.copy(centre).add(new THREE.Vector3(0.25, -0.85, 0.55).normalize().multiplyScalar(distance));
+    const distance = radius / Math.sin(THREE.MathUtils.degToRad(this.camera.fov / 2)) * 0.9 * (this.kind.distance || 1);
+    this.camera.position.copy(centre).add(v3(this.kind.view).normalize().multiplyScalar(distance));
     this.camera.near = Math.max(distance / 200, 0.5);
     this.camera.far = distance * 20;
     this.camera.updateProjectionMatrix();

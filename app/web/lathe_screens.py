@@ -124,37 +124,43 @@ def lathe_tool_info(env) -> dict | None:
     return info
 
 
-def _path_points(prep, start, tip) -> list[list[float]]:
-    """The planned NC reference points (MCS) of the program driven with ideal latches."""
+def path_steps(prep, start, tip) -> list[tuple[str, list[float]]]:
+    """The planned NC reference points (MCS) of the program driven with ideal latches, each with
+    how it is reached ("start", "move" or "probe")."""
     pos = np.asarray(start, dtype=float)
     points = []
 
     def mcs(p, coords):
         return tip.wcs2bcs.child2parent(p) if coords == "WCS" else np.asarray(p, dtype=float)
 
-    points.append([float(v) for v in mcs(pos, prep.coords)])
+    points.append(("start", [float(v) for v in mcs(pos, prep.coords)]))
     for step in lathe_planned_path(prep, start):
         if isinstance(step, MoveStep):
-            pos = np.asarray(step.target, dtype=float)
+            pos, kind = np.asarray(step.target, dtype=float), "move"
         elif isinstance(step, ProbeStep):
             travel = step.expected if step.expected is not None else step.distance / 2.0
-            pos = pos + travel * np.asarray(step.direction, dtype=float)
+            pos, kind = pos + travel * np.asarray(step.direction, dtype=float), "probe"
         else:
             continue
-        points.append([float(v) for v in mcs(pos, prep.coords)])
+        points.append((kind, [float(v) for v in mcs(pos, prep.coords)]))
     return points
 
 
-def _next_path(env, spec, params: dict) -> list[list[float]]:
-    """The planned path of the next NC Start from where the tool tip is (MCS points)."""
-    ctx = env.measuring_context()
+def next_path_steps(machine_service, ctx, spec, params: dict) -> list[tuple[str, list[float]]]:
+    """The planned path of the next NC Start from where the tool tip is (MCS points with their
+    kind): the task screen's picture and the 3D view (app/web/scene3d.py) draw the same path."""
     normalised = spec.validate(params, ctx.plane)
     plan_ctx = spec.plan_context(ctx, normalised)
     prep = prepare(spec.name, normalised, plan_ctx)
     tip = spec.tool_tip(ctx)
-    start = StepExecutor(env.machine.machine, ctx.chain().wcs2bcs, ctx.tool_length, ctx.plane.infeed_unit,
+    start = StepExecutor(machine_service.machine, ctx.chain().wcs2bcs, ctx.tool_length, ctx.plane.infeed_unit,
                          tip=tip).current(prep.coords)
-    return _path_points(prep, start, tip)
+    return path_steps(prep, start, tip)
+
+
+def _next_path(env, spec, params: dict) -> list[list[float]]:
+    """The planned path of the next NC Start from where the tool tip is (MCS points)."""
+    return [p for _kind, p in next_path_steps(env.machine, env.measuring_context(), spec, params)]
 
 
 def lathe_svgs(env, spec, params: dict | None, answer: dict | None) -> list:

@@ -2,7 +2,7 @@
 data from ``scene3d``) and in top and front view with a scale bar, live. In trainer mode (setting
 ``trainer_hide_part``) the part is left out, the probe is where the NC puts it, and the trainer
 panel shows the simulator's set-up error (app/services/trainer.py). A lathe in one view, X up and
-Z right (app/web/lathe_view.py), with no 3D panel."""
+Z right (app/web/lathe_view.py), beside its 3D panel (static/view3d_lathe.js, ``scene3d.build_lathe``)."""
 
 from __future__ import annotations
 
@@ -123,7 +123,9 @@ def _context(request: Request) -> dict:
     if scene.get("kind") == "lathe":                       # one view, X up and Z right (turning.md §0.1)
         return {"lathe_svg": Markup(lathe_svg(scene, services.machine.limits())),
                 "tip": scene.get("probe", {}).get("tip"), "lathe": True, "hidden": scene["hidden"],
-                "spindle_angle": scene.get("spindle_angle"), "views": None}
+                "spindle_angle": scene.get("spindle_angle"), "views": None,
+                "lathe_part": [{"type": p["type"], "diameter": p["diameter"], "length": abs(p["z"][1] - p["z"][0])}
+                               for p in scene.get("part") or []]}
     status = services.machine.status()
     return {"views": build_views(scene, services.machine.limits(), status["mcs"]["Z"]),
             "tip": scene.get("probe", {}).get("tip"), "hidden": scene["hidden"]}

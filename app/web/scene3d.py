@@ -10,6 +10,13 @@
 - ``touches``: the latched ball centres of the open measurement and of the last log entries;
 - ``measured``: what those log entries found (circles, rectangles, corner lines, edge faces): the
   part as measured.
+
+A lathe (``kind: "lathe"``, ``build_lathe``) has the same keys with its own ``solids``: the
+turned part as bodies of revolution about the spindle axis (MCS X = radius, Z along the
+spindle; the profile's cylinders and bores, eccentric by the spindle angle's e_X), the chuck,
+the reference grooves' rings and the tool probe's cube; ``probe`` adds F (the turret reference)
+and the tool lengths L1/L2 (the live NC tip is F − (L1, 0, L2)); ``measured`` holds the
+diameters (circles about the axis) and faces the 1- and 2-point measurements found.
 """
 
 from __future__ import annotations
@@ -29,6 +36,7 @@ from engine.planes import Plane
 from engine.types import MoveStep, ProbeStep
 
 from .failsafe import EXPECTED, PictureFailed, drawn
+from .lathe_screens import next_path_steps
 
 LOG_ENTRIES = 3          # the last measurements drawn as touches and results
 AXES = ("X", "Y", "Z")
@@ -48,6 +56,8 @@ def build(services) -> dict:
     hide = bool(gud.trainer_hide_part)
     scene = trainer.visible_scene(services, hide)
     status = machine.status()
+    if scene.get("kind") == "lathe":
+        return build_lathe(services, scene, status, hide)
     nc = trainer.nc_tip(status)
     probe = scene.get("probe") or {}
     offset = np.asarray(probe.get("tip", nc), dtype=float) - np.asarray(nc)
@@ -55,6 +65,7 @@ def build(services) -> dict:
     session = services.workflow.session if services.workflow is not None else None
     plane = machine.plane()
     return {
+        "kind": "mill",
         "hidden": hide,
         "limits": limits,
         "solids": {k: scene.get(k) for k in ("block", "prism", "circles", "rects", "spheres")},
@@ -86,6 +97,8 @@ def _plan(services, session) -> dict | None:
     spec = TASKS.get(session.task)
     if n is None or spec is None:
         return None
+    if spec.name.startswith("lathe."):
+        return _lathe_plan(services, session, spec, n)
 
     def plan():
         ctx = MeasuringEnv(services.db, services.machine, services.settings).measuring_context()
@@ -257,3 +270,94 @@ def _shapes(r: dict, frame: Frame, plane: Plane, touch_height: float | None = No
     if isinstance(r.get("p1"), dict) and isinstance(r.get("p2"), dict):
         shapes.append({"kind": "line", "from": at(r["p1"]), "to": at(r["p2"])})
     return shapes
+
+
+# --- the lathe ---------------------------------------------------------------------------------
+
+CHUCK_LENGTH = 40.0      # mm below the chuck face drawn (the 2D view draws the same)
+CHUCK_OVERSIZE = 25.0    # the chuck's radius beyond the part's largest
+
+
+def build_lathe(services, scene: dict, status: dict, hide: bool) -> dict:
+    """The lathe's 3D data (MCS, X radius): see the module's docstring."""
+    machine = services.machine
+    lengths = status.get("tool_lengths") or {}
+    l1, l2 = float(lengths.get("L1") or 0.0), float(lengths.get("L2") or 0.0)
+    mcs = status["mcs"]
+    nc = [float(mcs["X"]) - l1, 0.0, float(mcs["Z"]) - l2]
+    probe = scene.get("probe") or {}
+    tip = probe.get("tip") or nc
+    part = scene.get("part") or []
+    r_max = max([p["diameter"] / 2 + abs(p["axis_x"]) for p in part] or [20.0])
+    chuck = scene.get("chuck_face_z")
+    session = services.workflow.session if services.workflow is not None else None
+    return {
+        "kind": "lathe",
+        "hidden": hide,
+        "limits": {a: list(v) for a, v in machine.limits().items() if a in ("X", "Z")},
+        "solids": {
+            "part": [{"type": p["type"], "z": _vec(p["z"]), "diameter": float(p["diameter"]),
+                      "axis_x": float(p["axis_x"])} for p in part],
+            "chuck": None if chuck is None else {"face_z": float(chuck), "length": CHUCK_LENGTH,
+                                                 "diameter": 2.0 * (r_max + CHUCK_OVERSIZE)},
+            "grooves": [{"number": g["number"], "rings": [_vec(r) for r in g["rings"]]}
+                        for g in scene.get("grooves") or []],
+            "tool_probe": scene.get("tool_probe"),
+        },
+        "spindle_angle": scene.get("spindle_angle"),
+        "probe": {"tip": _vec(nc), "offset": _vec(np.asarray(tip, dtype=float) - np.asarray(nc)),
+                  "f": _vec(probe.get("f") or [mcs["X"], 0.0, mcs["Z"]]), "lengths": [l1, l2],
+                  "diameter": float(probe.get("diameter") or 0.0), "is_probe": bool(probe.get("is_probe")),
+                  "sl": probe.get("sl")},
+        "wcs": _wcs(machine),
+        "plan": _plan(services, session),
+        "touches": _session_touches(session) + _log_touches(services),
+        "measured": _lathe_measured(services),
+    }
+
+
+def _lathe_plan(services, session, spec, n: int) -> dict | None:
+    """The lathe task's next path as its screen draws it (``lathe_screens.next_path_steps``)."""
+    def plan():
+        ctx = MeasuringEnv(services.db, services.machine, services.settings).measuring_context()
+        return next_path_steps(services.machine, ctx, spec, session.params)
+
+    try:
+        steps = drawn("the 3D view's planned lathe path", plan, None)
+    except PictureFailed:
+        return None
+    if not steps:
+        return None
+    segments = [{"kind": "probe" if kind == "probe" else "move", "from": _vec(a), "to": _vec(b)}
+                for (_k, a), (kind, b) in zip(steps, steps[1:], strict=False)]
+    return {"task": session.task, "point": n, "segments": segments}
+
+
+def _lathe_measured(services) -> list[dict]:
+    """The diameters (circles about the spindle axis) and faces (planes normal to Z) that the
+    last 1- and 2-point measurements found, where they were measured."""
+    try:
+        frames = services.machine.stored_frames()
+    except EXPECTED:
+        return []
+    out = []
+    for entry in _recent(services):
+        if entry.get("task") not in ("lathe.point", "lathe.two_point"):
+            continue
+        frame = _entry_frame(entry, frames)
+        result, params = entry.get("result") or {}, entry.get("params") or {}
+        actual = result.get("diameter", result.get("actual"))
+        tips = [latch["tip_mcs"] for latches in (entry.get("raw") or {}).values() for latch in latches or []
+                if latch.get("triggered") and latch.get("tip_mcs")]
+        if frame is None or not tips or not isinstance(actual, int | float):
+            continue
+        touch = frame.parent2child(np.mean(np.asarray(tips, dtype=float), axis=0))
+        tag = {"log_id": entry["id"], "task": entry["task"]}
+        if params.get("axis") == "X":        # a diameter: the circle about the axis at the touches' Z
+            centre = frame.child2parent(np.array([0.0, 0.0, touch[2]]))
+            out.append({"kind": "circle", "at": _vec(centre), "normal": _vec(frame.dir_child2parent(np.eye(3)[2])),
+                        "diameter": float(actual), **tag})
+        elif params.get("axis") == "Z":      # a face at the measured Z
+            at = frame.child2parent(np.array([touch[0], 0.0, float(actual)]))
+            out.append({"kind": "face", "at": _vec(at), "normal": _vec(frame.dir_child2parent(np.eye(3)[2])), **tag})
+    return out
