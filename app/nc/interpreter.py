@@ -733,7 +733,7 @@ class Interpreter:
             self._located(plan.gcodes.get(OFFSET, plan.block), lambda: self.runtime.activate_offset(new.offset))
         plan.ev.commit()
         if plan.measurement is not None:
-            self._store_measurement(*plan.measurement)
+            self._store_measurement(*plan.measurement, diamon=new.diamon)
         self._modal = new
         if plan.msg is not None:
             self._message = plan.msg[1]
@@ -796,8 +796,14 @@ class Interpreter:
         # $AA_MW is given in the active WCS, also when G53 suppressed the frames of this block
         return result, (coords if not suppress else self._coordinates(new, False)), int(value)
 
-    def _store_measurement(self, result: MeasureResult, coords: Coordinates, probe_input: int) -> None:
-        """$AC_MEA[n], and on a switch $AA_MM (MCS) and $AA_MW (WCS, tool tip) of every axis."""
+    def _store_measurement(self, result: MeasureResult, coords: Coordinates, probe_input: int,
+                           diamon: bool | None = None) -> None:
+        """$AC_MEA[n], and on a switch $AA_MM (MCS) and $AA_MW (WCS, tool tip) of every axis. With
+        DIAMON (``diamon``, default the block's modal state) $AA_MW[X] is a diameter, as the WCS
+        position $AA_IW[X] and the X words; $AA_MM[X] stays the machine axis' radius, as $AA_IM
+        (turning.md §0.3: machine axes stay radius values)."""
+        if diamon is None:
+            diamon = self._modal.diamon
         v = self.variables
         v.set_system("$AC_MEA", bool(result.triggered), (probe_input,))
         if not result.triggered or result.latched_mcs is None:
@@ -807,7 +813,7 @@ class Interpreter:
         for a, value in latched.items():
             v.set_system("$AA_MM", float(value), (a,))
         for i, a in enumerate(GEOMETRY_AXES):
-            v.set_system("$AA_MW", float(wcs[i]), (a,))
+            v.set_system("$AA_MW", 2.0 * float(wcs[i]) if a == "X" and diamon else float(wcs[i]), (a,))
         for a, value in latched.items():
             if a not in GEOMETRY_AXES:
                 v.set_system("$AA_MW", coords.rotary_wcs(a, value), (a,))
@@ -844,7 +850,7 @@ class Interpreter:
                               f"G100 {axis}{_fmt(target)}: the probe did not switch between {axis}{_fmt(now[i])} "
                               f"and {axis}{_fmt(end[i])}")
         latched = coords.tip_wcs(result.latched_mcs)
-        self._store_measurement(result, coords, 1)
+        self._store_measurement(result, coords, 1, diamon=new.diamon)
         return new.measuring.record(axis, float(latched[i] - target))
 
     def _measuring_offsets(self, g: n.GCode, offsets: MeasuringOffsets, axis_values) -> MeasuringOffsets:
