@@ -4,7 +4,10 @@ parameter assignments and the call, SW 6.3 style: parameters set before the call
 and the way back from such a text to the form. ``read(render(c, p)) == (c, p)`` exactly:
 integers stay integers, reals are written with Python's shortest round-trip representation.
 The milling machine offers ``CYCLES``; a lathe offers ``LATHE_CYCLES`` (CYCLE982/973/974/994 with
-the parameters app.nc.cycles.lathe reads), and neither offers the other's.
+the parameters app.nc.cycles.lathe reads), and neither offers the other's. The lathe forms check
+``_MVAR`` digit by digit with the decoders the NC's cycles use (engine.turning_tools.decode_982,
+engine.turning_probe.decode_973; CYCLE974 0/100/1000, CYCLE994 1/2 by its range): a variant the
+cycle does not have is refused naming ``params._MVAR`` and the digits it may have.
 
     fields = CYCLES["CYCLE977"]                 # the form: parameter name, operator text, kind
     text = render("CYCLE977", {"_MVAR": 101, "_SETVAL": 20.0, "_KNUM": 1})
@@ -21,6 +24,9 @@ from app.i18n import N_
 from app.nc import nodes as n
 from app.nc.errors import NcSyntaxError
 from app.nc.parser import parse_program
+from engine.turning_probe import decode_973
+from engine.turning_tools import decode_982
+from engine.types import MeasuringError
 
 
 @dataclass(frozen=True)
@@ -124,12 +130,25 @@ def cycles_for(lathe: bool) -> dict[str, tuple[CycleField, ...]]:
 
 
 class CycleFormError(ValueError):
-    """Bad input to the cycle support, naming the field (``cycle``, ``params.<name>``, ``text``)."""
+    """Bad input to the cycle support, naming the field (``cycle``, ``params.<name>``, ``text``).
+    ``text``/``values``: the message as a catalogue msgid with its %-values, for the screen to
+    translate (the API answers ``message``, the English)."""
 
-    def __init__(self, field: str, message: str):
+    def __init__(self, field: str, message: str, text: str | None = None, values: dict | None = None):
         super().__init__(message)
         self.field = field
         self.message = message
+        self.text = text
+        self.values = values or {}
+
+    def translated(self, translate) -> str:
+        if self.text is None:
+            return self.message
+        return translate(self.text) % {k: translate(v) if isinstance(v, Reason) else v for k, v in self.values.items()}
+
+
+class Reason(str):
+    """A catalogue msgid given as a value of a message (translated with it)."""
 
 
 def fields_of(cycle: str, lathe: bool = False) -> dict[str, CycleField]:
@@ -158,6 +177,60 @@ def _value(field: CycleField, value: object) -> int | float:
     return value
 
 
+# --- the _MVAR digits of the lathe's cycles (the same decoders the NC's cycles use) -------------------
+_DIGITS_982 = Reason(N_(
+    "units 0 calibrate, 1 measure on _MA, 2 measure automatically; tens 0 tool probe _TP, "
+    "1 workpiece-related _TPW; mills only: hundreds 1 with reversal, thousands 0 length, 1 radius, "
+    "2 length and radius (automatic: 0), ten-thousands 1 radial position; hundred-thousands 1 "
+    "incremental (not automatic, not with length and radius); calibration has no mill digits"))
+_DIGITS_973 = Reason(N_(
+    "0 on a surface, or xxx13 in the reference groove: hundreds 1 with the effective ball diameter, "
+    "thousands 0 or 1 one direction, 2 both directions of _MA, ten-thousands 1 with the position deviation"))
+_ONE_DIRECTION_973 = Reason(N_(
+    "in one direction neither the effective ball diameter (hundreds digit) nor the position deviation "
+    "(ten-thousands digit) can be determined: set the thousands digit to 2 (both directions)"))
+_VARIANTS_974 = Reason(N_("0 tool offset or measure only, 100 zero offset, 1000 with reversal"))
+_NOT_A_VARIANT = N_("_MVAR=%(mvar)s is not a %(cycle)s variant: %(reason)s")
+
+
+def _variant_982(mvar: int) -> str | None:
+    try:
+        decode_982(mvar)
+    except MeasuringError:
+        return _DIGITS_982
+    return None
+
+
+def _variant_973(mvar: int) -> str | None:
+    try:
+        decode_973(mvar)
+    except MeasuringError:
+        d3, d4, d5 = (mvar // 100) % 10, (mvar // 1000) % 10, mvar // 10_000
+        if mvar % 100 == 13 and d3 in (0, 1) and d4 in (0, 1) and d5 in (0, 1) and (d3 or d5):
+            return _ONE_DIRECTION_973
+        return _DIGITS_973
+    return None
+
+
+def _variant_974(mvar: int) -> str | None:
+    return None if mvar in (0, 100, 1000) else _VARIANTS_974
+
+
+# cycle -> the reason its _MVAR is not one of its variants (None: it is)
+_VARIANTS = {"CYCLE982": _variant_982, "CYCLE973": _variant_973, "CYCLE974": _variant_974}
+
+
+def _check_variant(cycle: str, values: dict[str, int | float]) -> None:
+    check = _VARIANTS.get(cycle)
+    mvar = values.get("_MVAR")
+    if check is None or mvar is None:
+        return
+    reason = check(int(mvar))
+    if reason is not None:
+        details: dict[str, object] = {"mvar": int(mvar), "cycle": cycle, "reason": reason}
+        raise CycleFormError("params._MVAR", _NOT_A_VARIANT % details, _NOT_A_VARIANT, details)
+
+
 def _text_of(value: int | float) -> str:
     return str(value) if isinstance(value, int) else repr(float(value))
 
@@ -172,7 +245,9 @@ def render(cycle: str, params: dict, lathe: bool = False) -> str:
     if unknown:
         raise CycleFormError(f"params.{unknown[0]}", f"{unknown[0]} is not a parameter of {cycle} "
                              f"({', '.join(fields)})")
-    words = [f"{name}={_text_of(_value(field, params[name]))}" for name, field in fields.items() if name in params]
+    values = {name: _value(field, params[name]) for name, field in fields.items() if name in params}
+    _check_variant(cycle, values)
+    words = [f"{name}={_text_of(value)}" for name, value in values.items()]
     lines, line = [], ""
     for word in words:                  # blocks well below the NC's 512 characters
         if line and len(line) + 1 + len(word) > 72:

@@ -204,7 +204,7 @@ async def programs_cycle(request: Request, name: str, programs: ProgramsDep, nc:
             editing["text"] = text[:start] + block + text[start:]
             cursor = start + len(block)
     except cycle_forms.CycleFormError as exc:
-        error = exc.message
+        error = exc.translated(_)
     return _programs(request, programs, nc, {"editing": editing, "cycle": cycle, "cursor": cursor,
                                              "cycle_fields": [f.to_api(_) for f in offered[cycle]]
                                              if cycle in offered else None,

@@ -5,6 +5,7 @@ back into the form, and a bad value is refused naming the parameter."""
 
 from __future__ import annotations
 
+import re
 import sys
 from pathlib import Path
 
@@ -64,3 +65,36 @@ def test_lathe_cycle_inserted_at_the_cursor_and_read_back(tab, lathe_server):
     expect(editor).to_have_value("N10 G54 G18 T8 D1 DIAMON\n_MVAR=1000 _SETVAL=45.0 _MA=2 _FA=2.5\nCYCLE974\nN20 M30")
     with httpx.Client(base_url=lathe_server, timeout=30) as http:
         assert http.get("/api/programs/LATHECYC").json()["text"] == "N10 G54 G18 T8 D1 DIAMON\nN20 M30"
+
+
+@pytest.mark.parametrize(("lang", "words"), [("en", "both directions"), ("de", "beide Richtungen"),
+                                             ("zh", "两个方向")])
+def test_a_cycle973_variant_it_does_not_have_is_refused_naming_mvar(tab, lathe_server, lang, words):
+    """CYCLE973 in one direction (thousands digit 1) with the position deviation (ten-thousands
+    digit 1): the manual says it cannot be determined (turning.md §4.1); the form says why, in the
+    operator's language, and writes nothing; the manual's 12013 (both directions) is written."""
+    with httpx.Client(base_url=lathe_server, timeout=30) as http:
+        http.delete("/api/programs/LATHEMVAR")
+        made = http.post("/api/programs", json={"name": "LATHEMVAR", "text": "N10 G54 G18 T8 D1 DIAMON\nN20 M30"})
+        assert made.status_code == 201, made.text
+    tab.goto(f"/jog?lang={lang}")
+    tab.goto("/programs")
+    tab.locator('tr[data-program="LATHEMVAR"] button[hx-get$="/LATHEMVAR/edit"]').click()      # Edit
+    editor = tab.locator("#program-editor textarea")
+    expect(editor).to_have_value("N10 G54 G18 T8 D1 DIAMON\nN20 M30")
+    editor.click()
+    tab.keyboard.press("Control+End")
+    tab.keyboard.press("Home")
+    tab.locator("#cycle-choice").select_option("CYCLE973")
+    tab.locator("#cycle-show").click()
+    fields = tab.locator("#cycle-fields")
+    expect(fields).to_have_attribute("data-cycle", "CYCLE973")
+    fields.locator('input[data-param="_MVAR"]').fill("11013")
+    tab.locator("#cycle-insert").click()
+    error = tab.locator("#cycle-error")
+    expect(error).to_contain_text("_MVAR=11013")
+    expect(error).to_contain_text(words)
+    expect(editor).to_have_value("N10 G54 G18 T8 D1 DIAMON\nN20 M30")
+    fields.locator('input[data-param="_MVAR"]').fill("12013")
+    tab.locator("#cycle-insert").click()
+    expect(editor).to_have_value(re.compile(r"_MVAR=12013\b[^\n]*\nCYCLE973\nN20 M30$"))

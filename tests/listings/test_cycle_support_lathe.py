@@ -29,6 +29,8 @@ READ = {
     "CYCLE974": {"_MVAR", "_SETVAL", "_MA", "_STA1"} | _AUX | _BANDS,
     "CYCLE994": {"_MVAR", "_SETVAL", "_MA", "_SZA", "_SZO", "_CHBIT[7]"} | _AUX | _BANDS,
 }
+# a variant of each cycle other than its default (turning.md §3.1, §4.1; manual §6.5, §6.6)
+NOT_DEFAULT_VARIANT = {"CYCLE982": 1, "CYCLE973": 12113, "CYCLE974": 1000, "CYCLE994": 2}
 MILLING = {"CYCLE976", "CYCLE977", "CYCLE978", "CYCLE979", "CYCLE998", "CYCLE961", "CYCLE997", "CYCLE971"}
 
 
@@ -68,7 +70,7 @@ def test_the_lathe_offers_its_four_cycles_with_the_parameters_they_read(lathe):
 @pytest.mark.parametrize("cycle", sorted(READ))
 def test_each_lathe_form_round_trips_exactly(lathe, cycle):
     form = next(c for c in ok(lathe.get("/api/cycles"))["cycles"] if c["cycle"] == cycle)
-    params = _values(form)
+    params = {**_values(form), "_MVAR": NOT_DEFAULT_VARIANT[cycle]}
     text = ok(lathe.post("/api/cycles/render", json={"cycle": cycle, "params": params}))["text"]
     assert text.splitlines()[-1] == cycle
     back = ok(lathe.post("/api/cycles/read", json={"text": text}))
@@ -137,3 +139,40 @@ def test_the_written_calibration_measures_the_truth(lathe):
     assert record["trigger"]["X-"] == pytest.approx(R_TRUE - DL1, abs=1e-6)
     assert record["trigger"]["X+"] == pytest.approx(-R_TRUE - DL1, abs=1e-6)
     assert record["valid"] is True
+
+
+# the _MVAR values of turning.md §3.1 (CYCLE982, digits units first), §4.1 (CYCLE973), manual §6.5 (CYCLE974)
+VARIANTS = {
+    "CYCLE982": [0, 10, 100000, 100010,                        # calibrate (_TP / _TPW, incremental)
+                 1, 11, 101, 1001, 2001, 10001, 100001, 101001,  # measure: turning tool, mill digits, incremental
+                 2, 12, 102],                                   # automatic
+    "CYCLE973": [0, 13, 1013, 2013, 2113, 12013, 12113],
+    "CYCLE974": [0, 100, 1000],
+}
+NOT_VARIANTS = {
+    "CYCLE982": [3, 20, 100, 1010, 3001, 5001, 20001, 100002, 102001, 112001, 200001],
+    "CYCLE973": [1, 14, 113, 3013, 2213, 20013, 99999],
+    "CYCLE974": [1, 10, 101, 110, 999],
+}
+
+
+@pytest.mark.parametrize("cycle, mvar", [(c, v) for c, values in VARIANTS.items() for v in values])
+def test_the_lathe_forms_write_every_variant_of_the_manual(lathe, cycle, mvar):
+    text = ok(lathe.post("/api/cycles/render", json={"cycle": cycle, "params": {"_MVAR": mvar}}))["text"]
+    assert text == f"_MVAR={mvar}\n{cycle}"
+
+
+@pytest.mark.parametrize("cycle, mvar", [(c, v) for c, values in NOT_VARIANTS.items() for v in values])
+def test_an_mvar_the_cycle_does_not_have_is_refused_naming_the_field_and_its_digits(lathe, cycle, mvar):
+    error = ok(lathe.post("/api/cycles/render", json={"cycle": cycle, "params": {"_MVAR": mvar, "_FA": 2.0}}),
+               422)["error"]
+    assert error["field"] == "params._MVAR"
+    assert error["message"].startswith(f"_MVAR={mvar} is not a {cycle} variant: ")
+    assert "turning.md" not in error["message"]              # the operator's words, no spec reference
+
+
+@pytest.mark.parametrize("mvar", [11013, 1113, 10113, 11113])
+def test_one_direction_with_ball_diameter_or_position_deviation_says_why(lathe, mvar):
+    """turning.md §4.1 [L20293]: in one direction neither can be determined."""
+    error = ok(lathe.post("/api/cycles/render", json={"cycle": "CYCLE973", "params": {"_MVAR": mvar}}), 422)["error"]
+    assert error["field"] == "params._MVAR" and "both directions" in error["message"]
