@@ -305,7 +305,8 @@ def main(argv: list[str] | None = None) -> None:
     if settings.host in ("0.0.0.0", "::"):
         print(f"python -m app: serving the network; browsers must use one of the trusted host names "
               f"{', '.join(trusted_hosts(settings))} (add the machine's name with --trusted-host)", file=sys.stderr)
-    server = StoppingServer(uvicorn.Config(app, host=settings.host, port=settings.port, log_level="info"),
+    server = StoppingServer(uvicorn.Config(app, host=settings.host, port=settings.port, log_level="info",
+                                           access_log=False),
                             stop_motion=app.state.services.machine.reset)
     server.run()
 

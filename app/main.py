@@ -54,6 +54,7 @@ from app.services.probe_health import ProbeHealthService
 from app.services.probe_test import ProbeTestService
 from app.services.scenarios import read_scenario
 from app.web import web_router
+from app.web.fast_reads import CachedReads
 from app.web.language import LanguageMiddleware
 from app.web.static_files import STATIC_DIR, VersionedStaticFiles
 from app.workflow.service import WorkflowService
@@ -161,6 +162,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.add_middleware(asgi_csrf, cookie_name=CSRF_COOKIE, http_header="x-csrftoken",
                        signing_secret=access.csrf_secret(), skip_if_scope=csrf_exempt, cookie_samesite="Strict",
                        send_csrf_failed=csrf_failed)
+    app.add_middleware(CachedReads)                 # the polls from their cached bytes (app/web/fast_reads.py)
     app.add_middleware(AccessGuard, access=access)
     app.add_middleware(BodySizeLimit)
     app.add_middleware(HostGuard, allowed_hosts=trusted_hosts(settings))

@@ -54,6 +54,14 @@ def require(request: Request, function: str) -> Identity:
     return identity
 
 
+def may_view(request: Request) -> bool:
+    """``guard``'s read rule as a yes/no, raising nothing: the request may ``view``
+    (app/web/fast_reads.py answers a poll only then; otherwise the route's guard refuses)."""
+    identity = identity_of(request)
+    return (identity.kind != INVALID and identity.authenticated
+            and identity.may(required_level(_gud(request), "view")))
+
+
 def denied(request: Request, function: str) -> str:
     """'' when the request may do ``function``, else the reason (for disabled softkeys); remembered
     for the request (a table asks once per cell)."""

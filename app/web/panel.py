@@ -36,9 +36,21 @@ def header(request: Request):
 @router.get("/ui/position", name="panel_position")
 async def position(request: Request):
     """The live position values, rendered once per state version and what else they show (the
-    tab's panel, the settings, the language): a poll at rest costs no template (issue 30 item 2).
+    tab's panel, the settings, the language): a poll at rest costs no template (issue 30 item 2;
+    app/web/fast_reads.py answers a repeated poll before FastAPI's routing).
     On the event loop like ``GET /api/machine``: a hit waits for nothing, a worker-thread hop would
     cost more than the answer."""
+    snapshot, gud, made, key = _position_cache(request)
+    body = made.get(key)
+    if body is None:
+        body = render_block(request, "base.html", "position_values", {"status": snapshot.body, "gud": gud}).body
+        made[key] = body
+    return HTMLResponse(body)
+
+
+def _position_cache(request: Request) -> tuple:
+    """(snapshot, settings, the blocks made for them, this request's key): the blocks are kept
+    while the machine's snapshot and the settings stay the same (at most 64 panels and languages)."""
     services = request.app.state.services
     machine = services.machine
     snapshot = machine.snapshot()
@@ -49,11 +61,13 @@ async def position(request: Request):
     if cache is None or cache[0] is not snapshot or not (cache[1] is gud or cache[1] == gud) or len(cache[2]) > 64:
         cache = (snapshot, gud, dict[tuple, bytes]())
         request.app.state.position_cache = cache
-    body = cache[2].get(key)
-    if body is None:
-        body = render_block(request, "base.html", "position_values", {"status": snapshot.body, "gud": gud}).body
-        cache[2][key] = body
-    return HTMLResponse(body)
+    return snapshot, gud, cache[2], key
+
+
+def cached_position(request: Request) -> bytes | None:
+    """The position block's bytes for this request if made already for the current state, else None."""
+    _snapshot, _gud, made, key = _position_cache(request)
+    return made.get(key)
 
 
 def _panel(request: Request, machine, **chosen) -> PanelState:
