@@ -38,6 +38,20 @@ def _linuxcnc_folder(tmp_path, monkeypatch):
     monkeypatch.setenv("HMI_LINUXCNC_DIR", str(tmp_path / "linuxcnc"))
 
 
+# real time: a machine tool's braking (5 m/s², the scenario's 1 m/s² by default) and a 20 m/min rapid
+# keep the LinuxCNC tests short; the latch is interpolated inside the servo period, so what they
+# measure does not depend on either (test_linuxcnc_machine.py: the latch at 300 to 3000 mm/min)
+BRISK_MACHINE = {"decel": 5.0, "rapid": 20000.0}
+BRISK_POSITIONING = {"position_feed": 20000.0, "position_feed_infeed": 20000.0}
+
+
+def brisk(scenario: dict) -> dict:
+    """``scenario`` (a copy) on a machine with BRISK_MACHINE's braking and rapid."""
+    copy = json.loads(json.dumps(scenario))
+    copy.setdefault("machine", {}).update(BRISK_MACHINE)
+    return copy
+
+
 def linuxcnc_client(tmp_path: Path, scenario: dict):
     """The app on LinuxCNC (``--machine linuxcnc``) for ``scenario``, as a TestClient."""
     from fastapi.testclient import TestClient

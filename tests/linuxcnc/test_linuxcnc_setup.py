@@ -20,7 +20,7 @@ import time
 
 import numpy as np
 import pytest
-from conftest import linuxcnc_client
+from conftest import BRISK_POSITIONING, brisk, linuxcnc_client
 from flowkit import Flow, cal_scenario, ok
 from truthkit import rpy
 
@@ -34,7 +34,7 @@ def k_shift(sc: dict) -> np.ndarray:
 
 @pytest.mark.parametrize("feed", [300.0, 1000.0])
 def test_setup_into_g54_matches_the_pose_and_linuxcnc_holds_it(tmp_path, feed):
-    sc = cal_scenario()
+    sc = brisk(cal_scenario())
     t0 = time.monotonic()
     with contextlib.ExitStack() as stack:
         for attempt in (1, 2):
@@ -45,7 +45,7 @@ def test_setup_into_g54_matches_the_pose_and_linuxcnc_holds_it(tmp_path, feed):
             flow = Flow(client, sc)
             state = ok(client.get("/api/machine"))
             assert state["controller"] == "linuxcnc" and state["alarms"] == []
-            ok(client.put("/api/settings", json={"measuring_feed": feed}))
+            ok(client.put("/api/settings", json={**BRISK_POSITIONING, "measuring_feed": feed}))
             try:
                 flow.calibrate_radius()
                 break

@@ -2,8 +2,9 @@
 truth tests (tests/flows/test_tasks_truth.py, noise-free scenario, 1e-6 mm / 1e-6°): each case
 runs that test's body on an app whose machine is LinuxCNC (a fresh LinuxCNC per case, as the
 simulator's tests load a fresh scenario), so both controllers meet the same bar. Positioning runs
-at 10 m/min (collision-monitored all the same), measuring at 1000 mm/min (the latch does not
-depend on the feed; 300 mm/min is test_linuxcnc_setup.py's). One case per
+at 20 m/min (collision-monitored all the same) braking at 5 m/s² (conftest.brisk), measuring at
+3000 mm/min (the latch does not depend on the feed; 300 and 1000 mm/min are
+test_linuxcnc_setup.py's). One case per
 task (the corner in two variants); the simulator's tests cover the variants. spigot.4 (70 s in
 real time) is left to the simulator: hole.4 runs the same four-feature geometry here.
 
@@ -19,7 +20,7 @@ import re
 
 import pytest
 import test_tasks_truth as truth
-from conftest import linuxcnc_client
+from conftest import BRISK_POSITIONING, brisk, linuxcnc_client
 from truthkit import Operator, scenario
 
 CASES = [
@@ -42,20 +43,18 @@ CASES = [
 
 @pytest.mark.parametrize("name, case, kind, params", CASES, ids=[c[0] for c in CASES])
 def test_task_on_linuxcnc(tmp_path, name, case, kind, params):
-    sc = scenario(rot=(0.0, 0.0, truth.ROT_Z), kind=kind)
+    sc = brisk(scenario(rot=(0.0, 0.0, truth.ROT_Z), kind=kind))
     with linuxcnc_client(tmp_path, sc) as client:
         assert client.get("/api/machine").json()["controller"] == "linuxcnc"
-        # real time: positioning at 10 m/min (collision-monitored), measuring at 1000 mm/min keep CI short
-        assert client.put("/api/settings", json={"position_feed": 10000.0, "position_feed_infeed": 10000.0,
-                                                            "measuring_feed": 1000.0}
-                          ).status_code == 200
+        # real time: positioning at 20 m/min (collision-monitored), measuring at 3000 mm/min keep CI short
+        assert client.put("/api/settings", json={**BRISK_POSITIONING, "measuring_feed": 3000.0}).status_code == 200
         case(Operator(client, sc), **params)
 
 
 def test_the_tilted_plane_is_refused_and_linuxcnc_keeps_its_g54(tmp_path):
     """plane.align into G54 would need a rotation about X/Y: LinuxCNC refuses the frame (61321)
     and its G54 stays as it was."""
-    sc = scenario(rot=(0.6, -0.4, truth.ROT_Z))
+    sc = brisk(scenario(rot=(0.6, -0.4, truth.ROT_Z)))
     with linuxcnc_client(tmp_path, sc) as client:
         op = Operator(client, sc)
         op.put_offset("G54", trans=(2.0, 3.0, 4.0), rot=(0.0, 0.0, 1.0))

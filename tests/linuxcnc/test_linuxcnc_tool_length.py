@@ -4,12 +4,12 @@ scene; the simulator's flow helpers of tests/flows/test_tool_measuring_truth.py)
 
 from __future__ import annotations
 
-from conftest import linuxcnc_client
+from conftest import brisk, linuxcnc_client
 from test_tool_measuring_truth import CUTTER_T, SCENARIO, TOL, TRUE, Api
 
 
 def test_tool_length_within_2_um_of_truth(tmp_path):
-    with linuxcnc_client(tmp_path, SCENARIO) as client:
+    with linuxcnc_client(tmp_path, brisk(SCENARIO)) as client:
         api = Api(client)
         api.calibrate("length")
         nominal = api.tool(CUTTER_T)
