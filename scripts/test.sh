@@ -36,25 +36,31 @@ fi
 # import contracts (.importlinter): the layers of design.md §2 and no cycles, function-level imports included
 .venv/bin/lint-imports --no-cache >/dev/null || .venv/bin/lint-imports --no-cache
 if [ "$#" -gt 0 ]; then exec .venv/bin/python -m pytest "$@"; fi
-# Two streams at once, one per core: the browser tests one at a time (and the hardening tests, to
-# balance the two), beside all the others (so
-# they pass "beside a process that keeps one core busy", as CI's machine is shared). The browser
-# stream's output follows when both are done. Then the LinuxCNC tests on their own: one LinuxCNC
-# per computer. (pytest-xdist spread the browser tests over both workers: its groups do not hold
-# with this pytest, and two browsers at once made timing-bound tests fail.)
+# Two streams at once, one per core, so the browser and LinuxCNC tests pass "beside a process that
+# keeps one core busy", as on CI's shared machine:
+# - the browser tests one at a time, then the LinuxCNC tests (real time, mostly waiting on motion;
+#   one LinuxCNC per computer, so never two at once);
+# - beside them, all the other tests, then the plant mode's (docs/plant.md): the database,
+#   migration, concurrency and plant tests again on PostgreSQL, in a private cluster the tests
+#   start and stop (tests/pgcluster.py).
+# Every part runs; the status is the first failure's. The browser/LinuxCNC stream's output follows
+# when both are done. (pytest-xdist spread the browser tests over both workers: its groups do not
+# hold with this pytest, and two browsers at once made timing-bound tests fail.)
 streams=$(mktemp -d)
-.venv/bin/python -m pytest tests/e2e tests/hardening -m "not linuxcnc" -p no:cacheprovider \
-    --basetemp="$streams/browser-tmp" >"$streams/browser.log" 2>&1 &
+(
+    part=0
+    .venv/bin/python -m pytest tests/e2e -m "not linuxcnc" -p no:cacheprovider \
+        --basetemp="$streams/browser-tmp" || part=$?
+    .venv/bin/python -m pytest -m linuxcnc -p no:cacheprovider --basetemp="$streams/linuxcnc-tmp" \
+        || part=$((part ? part : $?))
+    exit "$part"
+) >"$streams/browser.log" 2>&1 &
 browser=$!
 status=0
-.venv/bin/python -m pytest --ignore=tests/e2e --ignore=tests/hardening -m "not linuxcnc" \
-    --basetemp="$streams/others-tmp" || status=$?
+.venv/bin/python -m pytest --ignore=tests/e2e -m "not linuxcnc" --basetemp="$streams/others-tmp" || status=$?
+.venv/bin/python -m pytest --db-engine=postgresql tests/db tests/plant || status=$((status ? status : $?))
 wait "$browser" || status=$((status ? status : $?))
-echo "--- the browser and hardening tests (run beside the others) ---"
+echo "--- the browser tests, then the LinuxCNC tests (run beside the others) ---"
 cat "$streams/browser.log"
 rm -rf "$streams"
-.venv/bin/python -m pytest -m linuxcnc || status=$((status ? status : $?))
-# the plant mode (docs/plant.md): the database, migration, concurrency and plant tests again on
-# PostgreSQL, in a private cluster the tests start and stop (tests/pgcluster.py)
-.venv/bin/python -m pytest --db-engine=postgresql tests/db tests/plant || status=$((status ? status : $?))
 exit "$status"
