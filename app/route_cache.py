@@ -55,7 +55,42 @@ def install() -> bool:
     setattr(_match, _MARK, True)
     _match.__wrapped__ = original          # type: ignore[attr-defined]
     _IncludedRouter._match = _match         # type: ignore[method-assign]
+    _remember_routes_versions()
     return True
+
+
+_epoch = [0]            # raised whenever any router's routes change
+
+
+def _remember_routes_versions() -> None:
+    """``APIRouter._get_routes_version()`` walks every route of every included router (about 60
+    calls and some thousand ``isinstance`` per request that the path cache does not answer, e.g.
+    one with a session id): its answer is kept per router until any router marks its routes
+    changed (``_mark_routes_changed``, FastAPI's only way to raise a version)."""
+    from fastapi.routing import APIRouter
+
+    get, mark = getattr(APIRouter, "_get_routes_version", None), getattr(APIRouter, "_mark_routes_changed", None)
+    if get is None or mark is None or getattr(get, _MARK, False):
+        return
+
+    def _mark_routes_changed(self) -> None:
+        _epoch[0] += 1
+        mark(self)
+
+    def _get_routes_version(self, seen=None) -> int:
+        if seen is not None:
+            return get(self, seen)
+        epoch = _epoch[0]           # read first: a change while walking leaves the kept answer stale
+        kept = self.__dict__.get(_MARK)
+        if kept is not None and kept[0] == epoch:
+            return kept[1]
+        version = get(self)
+        self.__dict__[_MARK] = (epoch, version)
+        return version
+
+    setattr(_get_routes_version, _MARK, True)
+    APIRouter._mark_routes_changed = _mark_routes_changed     # type: ignore[method-assign]
+    APIRouter._get_routes_version = _get_routes_version       # type: ignore[method-assign]
 
 
 def _copy_scope(child_scope: dict) -> dict:
