@@ -5,12 +5,18 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import sys
+from pathlib import Path
 
 import pytest
 from fastapi.testclient import TestClient
 from hmi_testdata import TEST_SCENARIO, test_scenario
 from live import CHROMIUM_ARGS, MIN_WAIT_MS, browser_tab, serve
 from pgcluster import database_settings
+
+LATHE_KIT = str(Path(__file__).resolve().parent / "lathe")     # lathe_kit: the lathe scenario and operator
+if LATHE_KIT not in sys.path:
+    sys.path.append(LATHE_KIT)
 
 # --- the database engine: SQLite by default, PostgreSQL with --db-engine=postgresql ------------
 
@@ -155,6 +161,29 @@ def browser():
 def page(browser, live_server):
     with browser_tab(browser, live_server) as tab:
         yield tab
+
+
+@pytest.fixture(scope="module")
+def lathe_server(tmp_path_factory):
+    """The app on the simulated lathe (tests/lathe/lathe_kit.py's scenario) served by uvicorn, one
+    per test module; yields its base URL."""
+    from lathe_kit import LATHE_SCENARIO
+
+    with serve(tmp_path_factory.mktemp("lathe-live"), LATHE_SCENARIO) as url:
+        yield url
+
+
+@pytest.fixture
+def lathe(lathe_server):
+    """The lathe server's API as lathe_kit's operator (``Lathe``), its machine and data reset to the
+    scenario. (Tests on a TestClient define their own ``lathe``.)"""
+    import httpx
+    from lathe_kit import LATHE_SCENARIO, Lathe
+
+    with httpx.Client(base_url=lathe_server, timeout=30) as http:
+        response = http.post("/api/sim/scenario", json={**LATHE_SCENARIO, "reset_data": True})
+        assert response.status_code == 200, response.text
+        yield Lathe(http)
 
 
 @pytest.fixture

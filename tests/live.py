@@ -40,6 +40,28 @@ def browser_tab(browser, base_url: str, width: int = 1280, height: int = 720, ti
         context.close()
 
 
+def watch_offline(page, base_url: str) -> dict:
+    """Block and record every request of ``page`` outside the HMI at ``base_url`` (the machine has no
+    internet), and record the console's errors, uncaught page errors and answers >= 400; returns
+    that record, {"outside": [...], "errors": [...]}, also as ``page.seen``."""
+    seen: dict[str, list[str]] = {"outside": [], "errors": []}
+
+    def only_local(route):
+        if route.request.url.startswith(base_url):
+            if route.request.url.endswith("/favicon.ico"):     # the HMI has no icon: not the page's error
+                return route.fulfill(status=204)
+            return route.continue_()
+        seen["outside"].append(route.request.url)
+        return route.abort()
+
+    page.route("**/*", only_local)
+    page.on("console", lambda m: m.type == "error" and seen["errors"].append(m.text))
+    page.on("pageerror", lambda e: seen["errors"].append(str(e)))
+    page.on("response", lambda r: r.status >= 400 and seen["errors"].append(f"{r.status} {r.url}"))
+    page.seen = seen
+    return seen
+
+
 def free_port() -> int:
     with socket.socket() as sock:
         sock.bind(("127.0.0.1", 0))

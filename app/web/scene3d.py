@@ -22,6 +22,7 @@ diameters (circles about the axis) and faces the 1- and 2-point measurements fou
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 
 import numpy as np
 
@@ -202,16 +203,29 @@ def _entry_frame(entry: dict, frames: dict[str, Frame]) -> Frame | None:
         return None
 
 
-def _measured(services, plane: Plane) -> list[dict]:
+def _framed_entries(services) -> Iterator[tuple[dict, Frame]]:
+    """The recent measurements, each with its frame (WCS -> BCS) as it was measured."""
     try:
         frames = services.machine.stored_frames()
     except EXPECTED:
-        return []
-    out = []
+        return
     for entry in _recent(services):
         frame = _entry_frame(entry, frames)
+        if frame is not None:
+            yield entry, frame
+
+
+def _touch_tips(entry: dict) -> list:
+    """The entry's triggered touches, the ball centre in MCS each."""
+    return [latch["tip_mcs"] for latches in (entry.get("raw") or {}).values() for latch in latches or []
+            if latch.get("triggered") and latch.get("tip_mcs")]
+
+
+def _measured(services, plane: Plane) -> list[dict]:
+    out = []
+    for entry, frame in _framed_entries(services):
         result = entry.get("result") or {}
-        if frame is None or not isinstance(result, dict):
+        if not isinstance(result, dict):
             continue
         out += [{**shape, "log_id": entry["id"], "task": entry["task"]}
                 for shape in _shapes(result, frame, plane, _touch_height(entry, frame, plane))]
@@ -221,8 +235,7 @@ def _measured(services, plane: Plane) -> list[dict]:
 def _touch_height(entry: dict, frame: Frame, plane: Plane) -> float | None:
     """The mean infeed coordinate (WCS of the measurement) of the entry's touches: where a result
     without points (a hole's centre and diameter) is drawn."""
-    tips = [latch["tip_mcs"] for latches in (entry.get("raw") or {}).values() for latch in latches or []
-            if latch.get("triggered") and latch.get("tip_mcs")]
+    tips = _touch_tips(entry)
     if not tips:
         return None
     mean = frame.parent2child(np.mean(np.asarray(tips, dtype=float), axis=0))
@@ -336,20 +349,14 @@ def _lathe_plan(services, session, spec, n: int) -> dict | None:
 def _lathe_measured(services) -> list[dict]:
     """The diameters (circles about the spindle axis) and faces (planes normal to Z) that the
     last 1- and 2-point measurements found, where they were measured."""
-    try:
-        frames = services.machine.stored_frames()
-    except EXPECTED:
-        return []
     out = []
-    for entry in _recent(services):
+    for entry, frame in _framed_entries(services):
         if entry.get("task") not in ("lathe.point", "lathe.two_point"):
             continue
-        frame = _entry_frame(entry, frames)
         result, params = entry.get("result") or {}, entry.get("params") or {}
         actual = result.get("diameter", result.get("actual"))
-        tips = [latch["tip_mcs"] for latches in (entry.get("raw") or {}).values() for latch in latches or []
-                if latch.get("triggered") and latch.get("tip_mcs")]
-        if frame is None or not tips or not isinstance(actual, int | float):
+        tips = _touch_tips(entry)
+        if not tips or not isinstance(actual, int | float):
             continue
         touch = frame.parent2child(np.mean(np.asarray(tips, dtype=float), axis=0))
         tag = {"log_id": entry["id"], "task": entry["task"]}

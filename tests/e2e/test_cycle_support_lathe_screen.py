@@ -6,25 +6,14 @@ back into the form, and a bad value is refused naming the parameter."""
 from __future__ import annotations
 
 import re
-import sys
-from pathlib import Path
 
 import httpx
 import pytest
-from live import browser_tab, serve
+from live import browser_tab
 from playwright.sync_api import expect
 from test_cycle_support_screen import insert_and_read_back
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "lathe"))
-from lathe_kit import LATHE_SCENARIO  # noqa: E402
-
 pytestmark = pytest.mark.e2e
-
-
-@pytest.fixture(scope="module")
-def lathe_server(tmp_path_factory):
-    with serve(tmp_path_factory.mktemp("lathe-cycles"), LATHE_SCENARIO) as url:
-        yield url
 
 
 @pytest.fixture

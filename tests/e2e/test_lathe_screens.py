@@ -9,32 +9,13 @@ scenario's truth (tests/lathe/lathe_kit.py), never from the HMI's answers.
 from __future__ import annotations
 
 import re
-import sys
-from pathlib import Path
 
-import httpx
 import pytest
-from live import browser_tab, serve
+from lathe_kit import TRUE_FACES
+from live import browser_tab
 from playwright.sync_api import expect
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "lathe"))
-from lathe_kit import LATHE_SCENARIO, TRUE_FACES, Lathe  # noqa: E402
-
 pytestmark = pytest.mark.e2e
-
-
-@pytest.fixture(scope="module")
-def lathe_server(tmp_path_factory):
-    with serve(tmp_path_factory.mktemp("lathe-live"), LATHE_SCENARIO) as url:
-        yield url
-
-
-@pytest.fixture
-def lathe(lathe_server):
-    with httpx.Client(base_url=lathe_server, timeout=30) as http:
-        response = http.post("/api/sim/scenario", json={**LATHE_SCENARIO, "reset_data": True})
-        assert response.status_code == 200, response.text
-        yield Lathe(http)
 
 
 @pytest.fixture

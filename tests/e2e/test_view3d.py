@@ -8,6 +8,7 @@ import re
 
 import pytest
 from hmi_testdata import BLOCK_TOP_Z, PROBE_LENGTH, TEST_SCENARIO
+from live import watch_offline
 from playwright.sync_api import expect
 
 pytestmark = pytest.mark.e2e
@@ -22,21 +23,7 @@ START = TEST_SCENARIO["start"]
 @pytest.fixture
 def watched(page, live_server):
     """The page with every request outside the HMI blocked and recorded, and the console's errors."""
-    seen = {"outside": [], "errors": []}
-
-    def only_local(route):
-        if route.request.url.startswith(live_server):
-            if route.request.url.endswith("/favicon.ico"):     # the HMI has no icon: not the view's error
-                return route.fulfill(status=204)
-            return route.continue_()
-        seen["outside"].append(route.request.url)
-        return route.abort()
-
-    page.route("**/*", only_local)
-    page.on("console", lambda m: m.type == "error" and seen["errors"].append(m.text))
-    page.on("pageerror", lambda e: seen["errors"].append(str(e)))
-    page.on("response", lambda r: r.status >= 400 and seen["errors"].append(f"{r.status} {r.url}"))
-    page.seen = seen
+    watch_offline(page, live_server)
     return page
 
 

@@ -8,16 +8,11 @@ answers."""
 from __future__ import annotations
 
 import re
-import sys
-from pathlib import Path
 
-import httpx
 import pytest
-from live import browser_tab, serve
+from lathe_kit import LATHE_SCENARIO
+from live import browser_tab, watch_offline
 from playwright.sync_api import expect
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "lathe"))
-from lathe_kit import LATHE_SCENARIO, Lathe  # noqa: E402
 
 pytestmark = pytest.mark.e2e
 
@@ -25,39 +20,11 @@ PROFILE = LATHE_SCENARIO["workpiece"]["profile"]
 GROOVES = LATHE_SCENARIO["grooves"]
 
 
-@pytest.fixture(scope="module")
-def lathe_server(tmp_path_factory):
-    with serve(tmp_path_factory.mktemp("lathe-3d"), LATHE_SCENARIO) as url:
-        yield url
-
-
-@pytest.fixture
-def lathe(lathe_server):
-    with httpx.Client(base_url=lathe_server, timeout=30) as http:
-        response = http.post("/api/sim/scenario", json={**LATHE_SCENARIO, "reset_data": True})
-        assert response.status_code == 200, response.text
-        yield Lathe(http)
-
-
 @pytest.fixture
 def tab(browser, lathe_server):
     """A page with every request outside the HMI blocked and recorded, and the console's errors."""
     with browser_tab(browser, lathe_server, timeout_ms=15000) as page:
-        seen = {"outside": [], "errors": []}
-
-        def only_local(route):
-            if route.request.url.startswith(lathe_server):
-                if route.request.url.endswith("/favicon.ico"):
-                    return route.fulfill(status=204)
-                return route.continue_()
-            seen["outside"].append(route.request.url)
-            return route.abort()
-
-        page.route("**/*", only_local)
-        page.on("console", lambda m: m.type == "error" and seen["errors"].append(m.text))
-        page.on("pageerror", lambda e: seen["errors"].append(str(e)))
-        page.on("response", lambda r: r.status >= 400 and seen["errors"].append(f"{r.status} {r.url}"))
-        page.seen = seen
+        watch_offline(page, lathe_server)
         yield page
 
 
