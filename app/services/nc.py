@@ -53,7 +53,7 @@ from app.services.memories import MEMORY_COUNT, WRITE_FUNCTION
 from app.services.memories import check_value as check_memory_value
 from app.services.protocols import ProtocolFileStore
 from app.services.settings import SettingsService
-from app.workflow.service import WorkflowService
+from app.workflow.service import WorkflowService, system_frame_missing
 from db import Database
 from engine import alarms
 from engine.frames import G500, FrameChain, is_basic
@@ -377,6 +377,9 @@ class NcService:
                  if isinstance(w, Assign) and w.target.name in PROTECTED}
         for name in sorted(names):
             authorize(None, None, function=PROTECTED[name])
+
+    def system_frame_missing(self) -> str | None:
+        return system_frame_missing(self._ms.machine)
 
     def measuring(self, ctx: CycleContext, settings: Mapping[str, Any], cycle: Mapping[str, Any]):
         block = ctx.block

@@ -16,7 +16,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from app.errors import ModeError, WorkflowError
-from app.machine.protocol import Lathe, MachineAlarm
+from app.machine.protocol import Lathe, MachineAlarm, MachineData
 from app.workflow import guard, probe_trust
 from app.workflow.context import (
     MEASURE_ONLY,
@@ -43,6 +43,16 @@ from engine.types import MeasuringError, averaged, translated
 __all__ = ["MEASURE_ONLY", "MeasuringContext", "WorkflowEnv", "WorkflowError", "WorkflowService"]
 
 log = logging.getLogger(__name__)
+
+
+def system_frame_missing(machine) -> str | None:
+    """Why every measurement is refused with 61016 (manual ch. 10's alarm table: source "all";
+    §9.1.1, jog-measuring.md §9.1): the cycles need the system frame for cycles, MD 28082 bit 5.
+    None when it is set, or when the control's machine data cannot be read."""
+    mask = machine.machine_data().get("28082") if isinstance(machine, MachineData) else None
+    if isinstance(mask, int | float) and not int(mask) & 0x20:
+        return f"MD 28082 MM_SYSTEM_FRAME_MASK is {int(mask):X}H, set bit 5 = 1"
+    return None
 
 
 class WorkflowService:
@@ -326,6 +336,7 @@ class WorkflowService:
         pending = self._env.machine.status().alarms
         if pending:
             raise WorkflowError(409, "alarm", f"{pending[-1].code} {pending[-1].text}: press Reset first")
+        self._check_system_frame()
         spec = self.spec(session.task)
         ctx = self._env.measuring_context()
         if spec.needs_probe and ctx.probe is None:
@@ -341,6 +352,12 @@ class WorkflowService:
         session.notice = None
         session.progress = {"point": n, "step": 0, "steps": None, "label": ""}
         return spec, n, ctx
+
+    def _check_system_frame(self) -> None:
+        missing = system_frame_missing(self._env.machine)
+        if missing:
+            raise WorkflowError(409, "alarm", f"{alarms.SYSTEM_FRAME_MISSING.number} {alarms.SYSTEM_FRAME_MISSING.text}: "
+                                              f"{missing}")
 
     @staticmethod
     def _start_point(session: MeasureSession, point: int | None) -> int:

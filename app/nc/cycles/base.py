@@ -57,6 +57,9 @@ class CycleHost(Protocol):
     def authorize(self, category, target) -> None:
         """Raise (an ``HmiError``) when whoever started the program may not write ``target``."""
 
+    def system_frame_missing(self) -> str | None:
+        """Why no measuring cycle may run (61016: MD 28082 bit 5), or None."""
+
 
 class CycleAlarm(Exception):
     """An alarm of a cycle with its catalogue entry (becomes an NcAlarm at the call)."""
@@ -258,10 +261,11 @@ class Call:
             return CycleAlarm(definition or alarms.NC_INTERNAL, str(alarm.get("text") or exc.message))
         if exc.code == "access_level":
             return CycleAlarm(alarms.NC_WRITE_PROTECTED, exc.message)
-        if exc.code in ("not_calibrated", "calibration_invalid", "repeatability"):     # app.workflow.probe_trust
-            number = exc.message[:5]
+        if exc.code in ("not_calibrated", "calibration_invalid", "repeatability", "alarm"):
+            number = exc.message[:5]             # "61016 text": app.workflow.probe_trust, NC Start's refusals
             found = alarms.by_number(int(number)) if number.isdigit() else None
-            return CycleAlarm(found or alarms.CALIBRATION_INVALID, exc.message[6:])
+            if found is not None or exc.code != "alarm":
+                return CycleAlarm(found or alarms.CALIBRATION_INVALID, exc.message[6:])
         if exc.code in ("invalid_param", "invalid_target", "unknown_task"):
             return CycleAlarm(alarms.WRONG_VARIANT, exc.message)
         return CycleAlarm(alarms.NC_VALUE_RANGE, exc.message)
@@ -374,6 +378,9 @@ def run_cycle(ctx: CycleContext, host: CycleHost, number: int, body: Callable[[C
     call = Call(ctx, host, number)
     call.ovi[2] = number
     try:
+        missing = host.system_frame_missing()      # before anything moves (manual ch. 10: "all")
+        if missing:
+            raise CycleAlarm(alarms.SYSTEM_FRAME_MISSING, missing)
         call.ovi[3] = call.variant
         call.ovi[5] = call.integer("_PRNUM")
         body(call)
