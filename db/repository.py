@@ -738,9 +738,41 @@ _utc_now = utc_now
 def _json_ready(value: Any, what: str) -> Any:
     """A deep copy of ``value`` as JSON gives it back (tuples -> lists); rejects NaN and objects."""
     try:
+        return _plain_copy(value)
+    except (_NotPlain, RecursionError):       # a cycle too: the round trip names it
+        pass
+    try:
         return json.loads(json.dumps(value, allow_nan=False))
     except (TypeError, ValueError) as error:
         raise ValueError(f"{what} is not JSON-ready: {error}") from None
+
+
+class _NotPlain(Exception):
+    """A value the JSON round trip must judge (a subclass, a non-text key, NaN, an object)."""
+
+
+def _plain_copy(value: Any) -> Any:
+    """The JSON round trip's answer for plain values, without the text (issue 30: the log and the
+    audit copy every field of every NC Start): exact types str, int, bool, None, finite float
+    (``float`` -> ``repr`` -> ``float`` is the same number), dict with text keys, list and tuple
+    (-> list). Anything else is ``_NotPlain``: the round trip answers or refuses it."""
+    kind = type(value)
+    if kind is str or kind is int or kind is bool or value is None:
+        return value
+    if kind is float:
+        if math.isfinite(value):
+            return value
+        raise _NotPlain
+    if kind is dict:
+        copied = {}
+        for key, item in value.items():
+            if type(key) is not str:
+                raise _NotPlain
+            copied[key] = _plain_copy(item)
+        return copied
+    if kind is list or kind is tuple:
+        return [_plain_copy(item) for item in value]
+    raise _NotPlain
 
 
 def _check_keys(data: Any, allowed: Iterable[str], what: str) -> None:
