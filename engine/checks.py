@@ -94,8 +94,9 @@ def unit_vector(value: npt.ArrayLike, name: str = "direction", dim: int | None =
     u = np.asarray(value, dtype=float)
     if dim is not None and u.shape != (dim,):
         raise ValueError(f"{name} must have shape ({dim},), got {u.shape}")
-    norm = float(np.linalg.norm(u))
-    if not np.isfinite(norm) or norm == 0.0:
+    flat = u.ravel(order="K")
+    norm = math.sqrt(flat.dot(flat))      # np.linalg.norm's own sum for real vectors, without its checks
+    if not math.isfinite(norm) or norm == 0.0:
         raise ValueError(f"{name} must be a finite non-zero vector, got {u}")
     return u / norm
 
