@@ -31,7 +31,7 @@ import numpy as np
 from app import checks
 from app.errors import ConflictError, HmiError, InvalidInput, ModeError, NotFoundError, TooLarge
 from app.machine.lathe import LatheStatus
-from app.machine.protocol import MachineAlarm, MachineBusy
+from app.machine.protocol import Lathe, MachineAlarm, MachineBusy
 from app.nc import (
     CallbackBacking,
     Interpreter,
@@ -51,6 +51,8 @@ from app.services.machine_service import MachineService
 from app.services.measuring import MeasuringEnv
 from app.services.memories import MEMORY_COUNT, WRITE_FUNCTION
 from app.services.memories import check_value as check_memory_value
+from app.services.nc_records import tool_probe_backing
+from app.services.probes import ToolProbeService
 from app.services.protocols import ProtocolFileStore
 from app.services.settings import SettingsService
 from app.workflow.service import WorkflowService, system_frame_missing
@@ -66,7 +68,7 @@ MDA = "MDA"
 #: NC variables that are the HMI's stored data -> the access function their write needs on every
 #: route (JSON API, screen, MDA, AUTO): one write path (issue 24 §7); the value checks and the
 #: audit row are the data's own (``_memory_backing``: the memories' range, ``put_memory``'s audit)
-PROTECTED = {"_EV": WRITE_FUNCTION, "_MV": WRITE_FUNCTION}
+PROTECTED = {"_EV": WRITE_FUNCTION, "_MV": WRITE_FUNCTION, "_TP": "probe_data", "_TPW": "probe_data"}
 
 
 def protected_function(reference: str) -> str | None:
@@ -334,7 +336,9 @@ class NcService:
         self._settings = settings
         self.runtime = MachineRuntime(machine_service, db)
         self.variables = Variables(axes=machine_service.axes, backings={
-            "_EV": _memory_backing(db, "EV", self._may_write), "_MV": _memory_backing(db, "MV", self._may_write)})
+            "_EV": _memory_backing(db, "EV", self._may_write), "_MV": _memory_backing(db, "MV", self._may_write),
+            **{name: tool_probe_backing(name, ToolProbeService(db, settings), self._on_lathe, self._may_write)
+               for name in ("_TP", "_TPW")}})
         self.protocol_files = ProtocolFileStore(db)     # CYCLE100..CYCLE106 write here (design.md §10.3)
         self.cycles = measuring_cycles(self)
         self.interpreter = Interpreter(self.runtime, self.variables, self.cycles)
@@ -349,6 +353,9 @@ class NcService:
         self._cycle_workflow: WorkflowService | None = None   # the measurement of the cycle running
         machine_service.on_reset(self._reset_stop, self._reset_wait)
         machine_service.add_interlock(self.interlock)
+
+    def _on_lathe(self) -> bool:
+        return isinstance(self._ms.machine, Lathe)
 
     # --- cycle host ------------------------------------------------------------------------------
     def authorize(self, category, target) -> None:
