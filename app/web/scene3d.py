@@ -30,7 +30,7 @@ from app.services import trainer
 from app.services.measuring import MeasuringEnv
 from app.workflow import guard, planning
 from app.workflow.executor import StepExecutor
-from app.workflow.tasks import TASKS
+from app.workflow.tasks import LATHE_SPECS, TASKS, Category
 from engine.frames import Frame, chain_of, is_basic
 from engine.plan import ideal_path
 from engine.planes import Plane
@@ -98,7 +98,7 @@ def _plan(services, session) -> dict | None:
     spec = TASKS.get(session.task)
     if n is None or spec is None:
         return None
-    if spec.name.startswith("lathe."):
+    if spec.name in LATHE_SPECS:
         return _lathe_plan(services, session, spec, n)
 
     def plan():
@@ -351,7 +351,8 @@ def _lathe_measured(services) -> list[dict]:
     last 1- and 2-point measurements found, where they were measured."""
     out = []
     for entry, frame in _framed_entries(services):
-        if entry.get("task") not in ("lathe.point", "lathe.two_point"):
+        spec = LATHE_SPECS.get(str(entry.get("task")))      # the lathe's 1- and 2-point measurements
+        if spec is None or spec.category != Category.WORKPIECE:
             continue
         result, params = entry.get("result") or {}, entry.get("params") or {}
         actual = result.get("diameter", result.get("actual"))
