@@ -265,6 +265,19 @@
     else post(key.dataset.url);
   });
 
+  // --- NC Start's answer given up on (htmx's timeout, a loaded computer): the measurement runs on
+  // in the HMI, but the screen stayed as before NC Start and nothing on it follows the session, so
+  // it asks for the screen with the progress or the outcome (data-progress), again while that
+  // answer too is given up on
+  document.addEventListener("htmx:timeout", function (event) {
+    var form = document.querySelector("#screen [data-progress]");
+    if (!form) return;
+    var detail = event.detail || {};
+    var path = detail.requestConfig && detail.requestConfig.path ? detail.requestConfig.path.split("?")[0] : "";
+    if (detail.elt === form || path === form.dataset.progress.split("?")[0])
+      htmx.ajax("GET", form.dataset.progress, { target: "#screen", swap: "outerHTML" });
+  });
+
   // --- continuous jog: press and hold (only when the MCP is in "Cont" mode). Hold-to-run: the
   // jog is renewed every RENEW_MS while the key is held; the server stops the axis 0.5 s after
   // the last renewal, so a lost tab, network or server stops it too (design.md §9.1). Each key

@@ -152,3 +152,26 @@ def test_the_outcome_shows_although_a_progress_answer_came_too_late(browser, liv
         assert held, "no answer with the outcome was held back: the test proved nothing"
         expect(page.locator("#task-result")).to_be_visible(timeout=10000)
         page.unroute("**/progress*")
+
+
+def test_the_outcome_shows_although_the_nc_start_answer_came_too_late(page, api):
+    """NC Start's own answer so late that the browser gives up on it (htmx's timeout): the
+    measurement runs on in the HMI, so the screen asks for its progress and shows the outcome
+    (a fresh-clone run at load 8 waited 30 s in vain for the result of a ring calibration)."""
+    cx, cy, top = TEST_SCENARIO["ring_gauge"]["center"]
+    for body in ({"Z": -100.0}, {"X": cx + 0.2, "Y": cy - 0.1}, {"Z": top - 8.0}):     # G500: WCS = tip
+        assert api.post("/api/machine/goto", json={**body, "coords": "WCS"}).status_code == 200
+    open_ring_calibration(page)
+    page.evaluate("() => { window.givenUp = 0; document.addEventListener('htmx:timeout', () => window.givenUp++); }")
+    held = []
+
+    def never_answered(route) -> None:          # the HMI takes NC Start; its answer never reaches the page
+        route.fetch()
+        held.append(route)
+
+    page.route("**/measure/task/*/start", never_answered)
+    page.locator("#nc-start").click()
+    page.wait_for_function("() => window.givenUp > 0")
+    assert held, "NC Start never reached the HMI: the test proved nothing"
+    expect(page.locator("#task-result")).to_be_visible()
+    assert api.get("/api/probes/1").json()["calibrated_at"] is not None      # the calibration was stored
