@@ -60,6 +60,11 @@ def centre_trigger_value(probe: ProbeRecord, direction_wcs: npt.ArrayLike, plane
     axis = parallel_axis(direction_wcs)
     if axis is None:
         raise ValueError("trigger values exist only for axis-parallel directions")
+    return _trigger_value_along(probe, axis, plane)
+
+
+def _trigger_value_along(probe: ProbeRecord, axis: tuple[int, float], plane: Plane | None) -> float:
+    """``centre_trigger_value`` for the axis and sign ``parallel_axis`` found (make_touch has them)."""
     j, sign = axis
     key = trigger_key(j, sign)
     r_nominal = probe.ball_diameter / 2.0
@@ -124,7 +129,7 @@ def make_touch(rec_wcs: npt.ArrayLike, direction_wcs: npt.ArrayLike, probe: Prob
     elif axis is not None:
         j, _sign = axis
         surface = centre.copy()
-        surface[j] = centre[j] - centre_trigger_value(probe, d_hat, plane)   # measuring-math §5.3 s_j = c_j − t
+        surface[j] = centre[j] - _trigger_value_along(probe, axis, plane)   # measuring-math §5.3 s_j = c_j − t
     else:
         surface = centre + effective_radius(probe) * d_hat                  # measuring-math §5.3 s = c + ρ·d̂
     latched = None if latched_mcs is None else np.asarray(latched_mcs, dtype=float)

@@ -133,6 +133,13 @@ def circle_from_touches(touches: Sequence[Touch], plane: Plane, kind: str,
     return centre, diameter
 
 
+def _opposite(d: FloatArray, u: FloatArray) -> bool:
+    """``np.allclose(d, -u, atol=1e-9)`` for finite unit vectors (``checks.unit_vector``'s), the
+    same comparison (|d − (−u)| <= atol + rtol·|−u|, rtol 1e-5) without its cost: called twice per
+    circle fit."""
+    return bool(np.all(np.abs(d + u) <= 1e-9 + 1e-05 * np.abs(u)))
+
+
 def circle_fit_of_touches(touches: Sequence[Touch], plane: Plane, kind: str, probe: ProbeRecord | None = None
                           ) -> tuple[FloatArray, float, CircleFit | None]:
     """(centre (3,), diameter) of a bore (``kind`` "hole") or shaft ("spigot").
@@ -154,7 +161,7 @@ def circle_fit_of_touches(touches: Sequence[Touch], plane: Plane, kind: str, pro
         v = checks.unit_vector(_ao(plane, touches[2].direction))
         d1 = checks.unit_vector(_ao(plane, touches[1].direction))
         d3 = checks.unit_vector(_ao(plane, touches[3].direction))
-        if abs(u @ v) < 1e-9 and np.allclose(d1, -u, atol=1e-9) and np.allclose(d3, -v, atol=1e-9):
+        if abs(u @ v) < 1e-9 and _opposite(d1, u) and _opposite(d3, v):
             s = [_ao(plane, t.surface) for t in touches]
             centre_u = 0.5 * (s[0] + s[1]) @ u          # jog-measuring §8.3 centre_a = (s1 + s2)/2
             centre_v = 0.5 * (s[2] + s[3]) @ v          # jog-measuring §8.3 centre_o = (s3 + s4)/2

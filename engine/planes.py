@@ -6,6 +6,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cache
 
 import numpy as np
 import numpy.typing as npt
@@ -34,21 +35,18 @@ class Plane:
 
     @property
     def index(self) -> tuple[int, int, int]:
-        return tuple(_AXIS_INDEX[a] for a in self.axes)  # type: ignore[return-value]
+        return _index_of(self.axes)
 
     @property
     def aop2xyz(self) -> FloatArray:
         """3x3 matrix whose columns are the unit vectors of a, o, p in XYZ: p_xyz = M @ p_aop."""
-        m = np.zeros((3, 3))
-        for col, idx in enumerate(self.index):
-            m[idx, col] = 1.0
-        return m
+        return _aop2xyz_of(self.axes).copy()
 
     def to_aop(self, p_xyz: npt.ArrayLike) -> FloatArray:
-        return np.asarray(p_xyz, dtype=float) @ self.aop2xyz
+        return np.asarray(p_xyz, dtype=float) @ _aop2xyz_of(self.axes)
 
     def to_xyz(self, p_aop: npt.ArrayLike) -> FloatArray:
-        return np.asarray(p_aop, dtype=float) @ self.aop2xyz.T
+        return np.asarray(p_aop, dtype=float) @ _aop2xyz_of(self.axes).T
 
     def unit(self, axis: str) -> FloatArray:
         e = np.zeros(3)
@@ -59,6 +57,22 @@ class Plane:
     def infeed_unit(self) -> FloatArray:
         """Unit vector of the applicate (tool axis, pointing from tip to spindle)."""
         return self.unit(self.infeed)
+
+
+@cache
+def _index_of(axes: tuple[str, str, str]) -> tuple[int, int, int]:
+    return tuple(_AXIS_INDEX[a] for a in axes)  # type: ignore[return-value]
+
+
+@cache
+def _aop2xyz_of(axes: tuple[str, str, str]) -> FloatArray:
+    """``Plane.aop2xyz`` built once per plane (issue 30: to_aop/to_xyz run some hundred times per
+    NC Start); read-only, the property hands out a copy."""
+    m = np.zeros((3, 3))
+    for col, idx in enumerate(_index_of(axes)):
+        m[idx, col] = 1.0
+    m.setflags(write=False)
+    return m
 
 
 PLANES = {
