@@ -38,8 +38,9 @@ fi
 if [ "$#" -gt 0 ]; then exec .venv/bin/python -m pytest "$@"; fi
 # Two streams at once, one per core, so the browser and LinuxCNC tests pass "beside a process that
 # keeps one core busy", as on CI's shared machine:
-# - the browser tests one at a time, then the LinuxCNC tests (real time, mostly waiting on motion;
-#   one LinuxCNC per computer, so never two at once);
+# - the LinuxCNC tests (real time, mostly waiting on motion; one LinuxCNC per computer, so never
+#   two at once), then the browser tests one at a time (the more sensitive to load: they finish
+#   after the other stream);
 # - beside them, all the other tests, then the plant mode's (docs/plant.md): the database,
 #   migration, concurrency and plant tests again on PostgreSQL, in a private cluster the tests
 #   start and stop (tests/pgcluster.py).
@@ -49,18 +50,19 @@ if [ "$#" -gt 0 ]; then exec .venv/bin/python -m pytest "$@"; fi
 streams=$(mktemp -d)
 (
     part=0
-    .venv/bin/python -m pytest tests/e2e -m "not linuxcnc" -p no:cacheprovider \
-        --basetemp="$streams/browser-tmp" || part=$?
     .venv/bin/python -m pytest -m linuxcnc -p no:cacheprovider --basetemp="$streams/linuxcnc-tmp" \
-        || part=$((part ? part : $?))
+        --durations=10 || part=$?
+    .venv/bin/python -m pytest tests/e2e -m "not linuxcnc" -p no:cacheprovider \
+        --basetemp="$streams/browser-tmp" --durations=10 || part=$((part ? part : $?))
     exit "$part"
 ) >"$streams/browser.log" 2>&1 &
 browser=$!
 status=0
-.venv/bin/python -m pytest --ignore=tests/e2e -m "not linuxcnc" --basetemp="$streams/others-tmp" || status=$?
+.venv/bin/python -m pytest --ignore=tests/e2e -m "not linuxcnc" --basetemp="$streams/others-tmp" --durations=15 \
+    || status=$?
 .venv/bin/python -m pytest --db-engine=postgresql tests/db tests/plant || status=$((status ? status : $?))
 wait "$browser" || status=$((status ? status : $?))
-echo "--- the browser tests, then the LinuxCNC tests (run beside the others) ---"
+echo "--- the LinuxCNC tests, then the browser tests (run beside the others) ---"
 cat "$streams/browser.log"
 rm -rf "$streams"
 exit "$status"
