@@ -140,28 +140,8 @@ def _opposite(d: FloatArray, u: FloatArray) -> bool:
     return bool(np.all(np.abs(d + u) <= 1e-9 + 1e-05 * np.abs(u)))
 
 
-# The last fit and what it was of: a point's program fits its touches as it ends (engine.plan_workpiece
-# circle_point) and the evaluation fits the same stored touches again (issue 30: NC Start). Kept
-# only for a tuple of touches (immutable, held here so its identity stays its own) with the same
-# plane, kind and probe record objects; the centre is handed out as a copy.
-_last_fit: tuple[tuple[Touch, ...], Plane, str, ProbeRecord | None, FloatArray, float, CircleFit | None] | None = None
-
-
 def circle_fit_of_touches(touches: Sequence[Touch], plane: Plane, kind: str, probe: ProbeRecord | None = None
                           ) -> tuple[FloatArray, float, CircleFit | None]:
-    """``_circle_fit`` of ``touches``; the same touches fitted just before are not fitted again."""
-    global _last_fit
-    last = _last_fit
-    if last is not None and last[0] is touches and last[1] is plane and last[2] == kind and last[3] is probe:
-        return last[4].copy(), last[5], last[6]
-    centre, diameter, fit = _circle_fit(touches, plane, kind, probe)
-    if type(touches) is tuple:
-        _last_fit = (touches, plane, kind, probe, centre.copy(), diameter, fit)
-    return centre, diameter, fit
-
-
-def _circle_fit(touches: Sequence[Touch], plane: Plane, kind: str, probe: ProbeRecord | None = None
-                ) -> tuple[FloatArray, float, CircleFit | None]:
     """(centre (3,), diameter) of a bore (``kind`` "hole") or shaft ("spigot").
 
     4 touches P1 +u, P2 −u, P3 +v, P4 −v (u ⟂ v, any probing angle; travel directions):
