@@ -11,7 +11,7 @@ import httpx
 import pytest
 from live import browser_tab
 from playwright.sync_api import expect
-from test_cycle_support_screen import insert_and_read_back
+from test_cycle_support_screen import insert_and_read_back, open_input_screen
 
 pytestmark = pytest.mark.e2e
 
@@ -28,19 +28,8 @@ def test_lathe_cycle_inserted_at_the_cursor_and_read_back(tab, lathe_server):
         http.delete("/api/programs/LATHECYC")
         made = http.post("/api/programs", json={"name": "LATHECYC", "text": "N10 G54 G18 T8 D1 DIAMON\nN20 M30"})
         assert made.status_code == 201, made.text
-    tab.goto("/programs")
-    tab.locator('tr[data-program="LATHECYC"]').get_by_role("button", name="Edit").click()
-    editor = tab.locator("#program-editor textarea")
-    expect(editor).to_have_value("N10 G54 G18 T8 D1 DIAMON\nN20 M30")
-    options = tab.locator("#cycle-choice option")
-    expect(options).to_have_text(["CYCLE982", "CYCLE973", "CYCLE974", "CYCLE994"])
-    editor.click()
-    tab.keyboard.press("Control+End")
-    tab.keyboard.press("Home")                                    # the cursor on line 2 (N20 M30)
-    tab.locator("#cycle-choice").select_option("CYCLE974")
-    tab.locator("#cycle-show").click()
-    fields = tab.locator("#cycle-fields")
-    expect(fields).to_have_attribute("data-cycle", "CYCLE974")
+    fields = open_input_screen(tab, "LATHECYC", "N10 G54 G18 T8 D1 DIAMON\nN20 M30", "CYCLE974")
+    expect(tab.locator("#cycle-choice option")).to_have_text(["CYCLE982", "CYCLE973", "CYCLE974", "CYCLE994"])
     expect(fields).to_contain_text("_STA1")                       # the manual's names beside the texts
     expect(fields).to_contain_text("Start angle of the reversal")
     # inserted, then another input screen, and the call at the cursor read back into the form
@@ -51,7 +40,7 @@ def test_lathe_cycle_inserted_at_the_cursor_and_read_back(tab, lathe_server):
     fields.locator('input[data-param="_MA"]').fill("4")
     tab.locator("#cycle-insert").click()
     expect(tab.locator("#cycle-error")).to_contain_text("_MA")
-    expect(editor).to_have_value("N10 G54 G18 T8 D1 DIAMON\n_MVAR=1000 _SETVAL=45.0 _MA=2 _FA=2.5\nCYCLE974\nN20 M30")
+    expect(tab.locator("#program-editor textarea")).to_have_value("N10 G54 G18 T8 D1 DIAMON\n_MVAR=1000 _SETVAL=45.0 _MA=2 _FA=2.5\nCYCLE974\nN20 M30")
     with httpx.Client(base_url=lathe_server, timeout=30) as http:
         assert http.get("/api/programs/LATHECYC").json()["text"] == "N10 G54 G18 T8 D1 DIAMON\nN20 M30"
 
@@ -67,17 +56,8 @@ def test_a_cycle973_variant_it_does_not_have_is_refused_naming_mvar(tab, lathe_s
         made = http.post("/api/programs", json={"name": "LATHEMVAR", "text": "N10 G54 G18 T8 D1 DIAMON\nN20 M30"})
         assert made.status_code == 201, made.text
     tab.goto(f"/jog?lang={lang}")
-    tab.goto("/programs")
-    tab.locator('tr[data-program="LATHEMVAR"] button[hx-get$="/LATHEMVAR/edit"]').click()      # Edit
+    fields = open_input_screen(tab, "LATHEMVAR", "N10 G54 G18 T8 D1 DIAMON\nN20 M30", "CYCLE973")
     editor = tab.locator("#program-editor textarea")
-    expect(editor).to_have_value("N10 G54 G18 T8 D1 DIAMON\nN20 M30")
-    editor.click()
-    tab.keyboard.press("Control+End")
-    tab.keyboard.press("Home")
-    tab.locator("#cycle-choice").select_option("CYCLE973")
-    tab.locator("#cycle-show").click()
-    fields = tab.locator("#cycle-fields")
-    expect(fields).to_have_attribute("data-cycle", "CYCLE973")
     fields.locator('input[data-param="_MVAR"]').fill("11013")
     tab.locator("#cycle-insert").click()
     error = tab.locator("#cycle-error")

@@ -35,20 +35,27 @@ def insert_and_read_back(page, cycle: str, filled: dict[str, str], program: str,
     return fields
 
 
+def open_input_screen(page, program: str, text: str, cycle: str):
+    """The program ``program`` (holding ``text``, two lines) opened in the editor, the cursor on its
+    line 2, and the input screen of ``cycle`` shown there; its fields."""
+    page.goto("/programs")
+    page.locator(f'tr[data-program="{program}"] button[hx-get$="/{program}/edit"]').click()   # Edit, any language
+    editor = page.locator("#program-editor textarea")
+    expect(editor).to_have_value(text)
+    editor.click()
+    page.keyboard.press("Control+End")
+    page.keyboard.press("Home")                                   # the cursor on line 2
+    page.locator("#cycle-choice").select_option(cycle)
+    page.locator("#cycle-show").click()
+    fields = page.locator("#cycle-fields")
+    expect(fields).to_have_attribute("data-cycle", cycle)
+    return fields
+
+
 def test_insert_a_cycle_at_the_cursor_and_read_it_back(page, api):
     api.delete("/api/programs/CYCSUP")
     assert api.post("/api/programs", json={"name": "CYCSUP", "text": "N10 G54 G0 X0 Y0\nN20 M30"}).status_code == 201
-    page.goto("/programs")
-    page.locator('tr[data-program="CYCSUP"]').get_by_role("button", name="Edit").click()
-    editor = page.locator("#program-editor textarea")
-    expect(editor).to_have_value("N10 G54 G0 X0 Y0\nN20 M30")
-    editor.click()
-    page.keyboard.press("Control+End")
-    page.keyboard.press("Home")                                   # the cursor on line 2 (N20 M30)
-    page.locator("#cycle-choice").select_option("CYCLE977")
-    page.locator("#cycle-show").click()
-    fields = page.locator("#cycle-fields")
-    expect(fields).to_have_attribute("data-cycle", "CYCLE977")
+    fields = open_input_screen(page, "CYCSUP", "N10 G54 G0 X0 Y0\nN20 M30", "CYCLE977")
     expect(fields).to_contain_text("_MVAR")                       # the manual's name beside the text
     # inserted, then opened again: a new input screen, and the call at the cursor read back
     fields = insert_and_read_back(page, "CYCLE977", {"_MVAR": "101", "_SETVAL": "20.5", "_KNUM": "1"},
