@@ -181,8 +181,10 @@ def cycle976(call: Call) -> None:
 
 
 def _calibrate971(call: Call, env, ma: int, v: int) -> None:
-    """_MVAR 0 / 100000: calibrate the tool probe (length, or length and diameter)."""
-    if ma not in (1, 2, 3, 102, 201):
+    """_MVAR 0 / 100000: calibrate the tool probe (length, or length and diameter). The automatic
+    calibration (100000) calibrates every direction and needs no ``_MA`` (manual §5.2.3,
+    ``%_N_AUTO_KALIBRIEREN_MPF`` sets none)."""
+    if not (v == 100000 and ma == 0) and ma not in (1, 2, 3, 102, 201):
         raise CycleAlarm(alarms.MEASURING_AXIS, f"_MA = {ma}: 1, 2, 3, 102 or 201")
     mode = "length" if ma == 3 and v == 0 else "length_diameter"
     old = dict((env.context().extra.get("tool_probe") or {}).get("trigger") or {})
