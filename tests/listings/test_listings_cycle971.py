@@ -13,7 +13,12 @@ from __future__ import annotations
 
 import pytest
 from listing_kit import G54, Machine, scenario
-from manual_listings import AUTO_KALIBRIEREN_7895, KALIBRIEREN_MTWZ_7510, KALIBRIEREN_MTWZ_X_7620, T3_MESSEN_8342
+from manual_listings import (
+    AUTO_KALIBRIEREN_7895,
+    KALIBRIEREN_MTWZ_7510,
+    KALIBRIEREN_MTWZ_X_7620,
+    T3_MESSEN_8342,
+)
 
 DISC = 20.0
 TP = (70.0, 90.0, 95.0)            # under the printed SUPA X70 Y90; the tip at SUPA Z100 is 5 mm above
