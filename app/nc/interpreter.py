@@ -729,7 +729,9 @@ class Interpreter:
     # --- commit, then the cycle and the program flow ---------------------------------------------------
     def _commit(self, plan: _Plan) -> None:
         new = plan.new
-        if new.offset != plan.before.offset:
+        if new.offset != plan.before.offset or OFFSET in plan.gcodes:
+            # programming the active WO again re-selects it with its current data (the manual's
+            # §5.7 listing, N90 "G54 C0": only then the written C offset takes effect)
             self._located(plan.gcodes.get(OFFSET, plan.block), lambda: self.runtime.activate_offset(new.offset))
         plan.ev.commit()
         if plan.measurement is not None:
