@@ -55,6 +55,9 @@ def test_positions_follow_a_move_without_polling(browser, live_server, api):
     with browser_tab(browser, live_server) as page:
         requests: list[str] = []
         page.on("request", lambda r: requests.append(r.url))
+        # every time the live feed asks the screen again (static/live.js: "hmi-state" on the body)
+        page.add_init_script("window.stateAsks = 0;"
+                             "document.addEventListener('hmi-state', () => window.stateAsks++, true);")
         page.goto("/jog")
         cell = page.locator('#position-values td.value[data-axis="X"]')
         wcs_x = TEST_SCENARIO["start"]["X"]                   # G500: the WCS X is the axis
@@ -75,7 +78,12 @@ def test_positions_follow_a_move_without_polling(browser, live_server, api):
         # >= 10 updates a second while moving: at least 12 positions on the way in 1.2 s
         assert len(between) >= 12, f"the position was shown at only {sorted(between)} on its way"
         polls = [u for u in requests if u.endswith("/ui/position") or u.endswith("/ui/header")]
-        assert len(polls) <= 6, f"{len(polls)} position/header requests: still polling"
+        asks = page.evaluate("window.stateAsks")              # read after: each poll's ask is counted
+        # the header and the position block are fetched once per ask, when the state changes (the
+        # first event, the move's start and end, once more for an answer a newer state overtook),
+        # never on a timer (a 1.2 s move polled at 5 Hz would be some 12 more)
+        assert len(polls) <= 2 * asks, f"{len(polls)} position/header requests for {asks} asks: still polling"
+        assert asks <= 6, f"the screen was asked again {asks} times for one move"
         z = page.locator('#position-values td.value[data-axis="Z"]')
         expect(z).to_have_text(f"{TEST_SCENARIO['start']['Z'] - PROBE_LENGTH:.3f}")
 
