@@ -20,6 +20,8 @@ route's headers (``content-length``, ``content-type``) and body.
 
 from __future__ import annotations
 
+import logging
+
 from starlette.requests import Request
 
 from app.access.deps import may_view
@@ -29,6 +31,7 @@ from .panel import cached_position
 JSON_TYPE = b"application/json"
 HTML_TYPE = b"text/html; charset=utf-8"
 MACHINE, POSITION = "api_machine", "panel_position"      # the routes' names: their paths are the app's
+log = logging.getLogger("app.web")
 
 
 class CachedReads:
@@ -71,6 +74,8 @@ class CachedReads:
                 return made[1], list(made[2])
             body = cached_position(request)
         except Exception:       # noqa: BLE001 - the route reads it again and its error handlers answer
+            # not silent: a fault of this lane itself would otherwise send every poll the slow way unseen
+            log.debug("cached read of %s fell back to the route", route, exc_info=True)
             return None
         return None if body is None else (body, _headers(body, HTML_TYPE))
 
