@@ -62,8 +62,12 @@ def tool_probe_backing(name: str, records: ToolProbeService, is_lathe: Callable[
         record = stored(n) or {"number": n}
         if trigger:
             record[field] = {**(record.get(field) or {}), trigger: float(value)}
+        elif field in ("axes", "type"):
+            if float(value) != int(value):      # a code, not a length: 133.5 is no axes code, not 133
+                raise InvalidValue(f"{name}[{key[0]},{key[1]}] = {value:g}: the {field} code is a whole number")
+            record[field] = int(value)
         else:
-            record[field] = int(value) if field in ("axes", "type") else float(value)
+            record[field] = float(value)
         try:
             records.put(n, record, source="nc")
         except (InvalidInput, NotFoundError) as exc:

@@ -57,6 +57,20 @@ def test_a_value_the_record_refuses_is_an_alarm_and_changes_nothing(client):
     assert client.get("/api/tool-probes/1").json()["type"] == 101
 
 
+def test_a_fractional_code_is_refused_not_truncated(client):
+    """The axes code and the type are codes (jog-measuring.md §9.2): 133.5 is refused by name,
+    the record keeps 133 and 101."""
+    assert client.put("/api/tool-probes/1", json=MILL_RECORD).status_code == 200
+    for word in ("_TP[0,7]=133.5", "_TP[0,8]=101.25"):
+        refused = run(client, word)
+        assert refused["state"] == "alarm", refused
+        assert word.split("=")[0] in refused["alarm"]["message"] and "whole number" in refused["alarm"]["message"]
+    record = client.get("/api/tool-probes/1").json()
+    assert (record["axes"], record["type"]) == (133, 101)
+    assert run(client, "_TP[0,7]=132.0")["state"] == "done"         # a whole number written as a real is one
+    assert client.get("/api/tool-probes/1").json()["axes"] == 132
+
+
 def test_on_the_lathe_the_calibrated_faces_read_in_the_turning_layout(tmp_path):
     with lathe_client(tmp_path) as client:
         lathe = Lathe(client)
