@@ -129,15 +129,20 @@ class SettingsService:
 
 
 def _lenient(stored: dict) -> GudSettings:
-    defaults = GudSettings()
+    """The stored values over the defaults; a stored key this version does not know, or whose value
+    it refuses (a database of an older or newer HMI), is left out and its default stands."""
+    defaults = GudSettings().model_dump()
     stored = legacy_units(stored)           # a database of wave 1: inch_display without units
+    known = {key: value for key, value in stored.items() if key in GudSettings.model_fields}
+    try:                                    # the usual case: they were stored together, validated
+        return GudSettings.model_validate({**defaults, **known})
+    except ValidationError:
+        pass
     values = {}
-    for key, value in stored.items():
-        if key not in GudSettings.model_fields:
-            continue
+    for key, value in known.items():
         try:
-            GudSettings.model_validate({**defaults.model_dump(), key: value})
+            GudSettings.model_validate({**defaults, key: value})
         except ValidationError:
             continue
         values[key] = value
-    return GudSettings.model_validate({**defaults.model_dump(), **values})
+    return GudSettings.model_validate({**defaults, **values})
