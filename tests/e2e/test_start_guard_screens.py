@@ -33,6 +33,7 @@ def hole1_screen_with_diameter(page, diameter: float):
     field = page.locator('#task-form [name="diameter"]')
     field.fill(f"{diameter:g}")
     field.press("Tab")
+    expect(field).to_have_value(f"{diameter:g}")     # kept after the field's check has answered
     return field
 
 
