@@ -13,6 +13,9 @@ same as those of the JOG tasks.
   ``_STA1 + (i−1)·_INCA`` around the setpoint centre, the probe moving on a circle (polyline)
   ``_FA`` from the nominal contour between them; the stored ``CirclePoint`` is evaluated by
   ``engine.evaluate.circle_from_touches`` (circle fit of the ball centres, R ± ρ: CYCLE116).
+- ``angle_line_program``: CYCLE979 slot/web (measuring-math §10.2): one touch per point along ±û
+  on the line through the setpoint centre at ``_STA1``, the web crossed over with ``_ID``; the
+  points are evaluated by ``engine.evaluate.distance_along_line``.
 - ``sphere_program`` / ``evaluate_sphere``: CYCLE997 one sphere (measuring-math §13.2), paraxial (±a at the
   nominal height, ±o through the found a-centre, −p on top of the found centre) or at an angle
   (radial touches on the horizontal section, CYCLE116 of their ball centres), with or without
@@ -32,13 +35,14 @@ import numpy.typing as npt
 
 from engine import alarms
 from engine.compensation import effective_radius, make_touch
+from engine.evaluate import line_unit
 from engine.fit import fit_circle
 from engine.frames import Frame
 from engine.params import MAX_CIRCLE_POINTS, MIN_CIRCLE_POINTS
 from engine.plan_base import Motion, PlanContext
 from engine.plan_workpiece import Program, ball_offset, circle_point
 from engine.planes import Plane
-from engine.types import CirclePoint, FloatArray, MeasuringError, Touch
+from engine.types import CirclePoint, EdgePoint, FloatArray, MeasuringError, Touch
 
 ARC_STEP_DEG = 10.0          # circular intermediate moves as chords of at most this angle
 
@@ -102,6 +106,46 @@ def angle_circle_program(params: dict[str, Any], start: FloatArray, ctx: PlanCon
                                   latched_mcs=latch.latched_mcs))
         yield from m.to_ball(centre + radius * u, f"{label} P{i + 1} retract")
     return circle_point(tuple(touches), ctx, inner)
+
+
+# --- CYCLE979 slot / web at an angle (measuring-math §10.2) --------------------------------------
+
+def angle_line_program(params: dict[str, Any], n: int, start: FloatArray, ctx: PlanContext, label: str
+                       ) -> Program[EdgePoint]:
+    """CYCLE979 slot (``inner``) or web, point ``n`` (1, 2) on the line through ``center`` (a, o)
+    along û = (cos _STA1, sin _STA1) (manual §5.6.1, measuring-math §10.2). ``params`` =
+    {"center", "width" (_SETVAL), "start_angle" (_STA1), "inner", "lift" (web: _ID > 0 above the
+    measuring height to cross over)}. Measuring height = the start height.
+
+    Slot: P1 travels +û, P2 −û; web: P1 from the +û side travelling −û, P2 from the −û side
+    travelling +û, lifted by _ID to cross over (as CYCLE977's web: up, over, down). Each probing
+    starts with the ball ``_FA`` from the nominal wall (P1', P2'); after P1 the probe goes back to
+    P1', after P2 it stays at P2': the cycle ends ``_FA`` before the last point (manual §5.6.1)."""
+    plane = ctx.plane
+    m = Motion(start, ctx, ball_offset=ball_offset(ctx))
+    inner = bool(params["inner"])
+    rho, fa = effective_radius(ctx.probe), ctx.measuring_path
+    half = float(params["width"]) / 2.0
+    reach = half - rho - fa if inner else half + rho + fa       # centre -> P1'/P2' (ball centre)
+    if reach <= 0.0:
+        raise MeasuringError(alarms.MEASURING_PATH, f"slot {2 * half:g} too narrow for the probe and _FA {fa:g}")
+    u = line_unit(plane, float(params["start_angle"]))            # the evaluation's û
+    here = m.start + m.ball_offset
+    height = float(plane.to_aop(here)[2])
+    ca, co = (float(v) for v in params["center"])
+    centre = plane.to_xyz(np.array([ca, co, height]))
+    side = 1.0 if n == 1 else -1.0                              # P1 on the +û side, P2 on the −û side
+    before = centre + side * reach * u
+    d = side * u if inner else -side * u
+    if n == 2 and not inner:
+        lift = float(params["lift"]) * plane.infeed_unit
+        yield from m.to_ball(here + lift, f"{label} lift")
+        yield from m.to_ball(before + lift, f"{label} over the web")
+    yield from m.to_ball(before, f"{label} start")
+    latch = yield from m.probe(d, 2.0 * fa, label, expected=fa)
+    yield from m.to_ball(before, f"{label} retract")
+    return EdgePoint(make_touch(latch.rec, d, ctx.probe, plane, skew_wcs=ctx.skew_wcs, spindle_angle=ctx.spindle_angle,
+                                wcs2bcs=ctx.wcs2bcs, latched_mcs=latch.latched_mcs))
 
 
 # --- CYCLE997 sphere (measuring-math §13.2) -----------------------------------------------------

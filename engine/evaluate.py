@@ -289,8 +289,11 @@ def evaluate_edge_align(task: str, params: dict[str, Any], points: Sequence[Stor
 
 def evaluate_edge_distance(task: str, params: dict[str, Any], points: Sequence[StoredPoint], plane: Plane,
         probe: ProbeRecord) -> TaskResult:
-    """Distance 2 edges (jog-measuring §2.5.3): L = |e2 − e1|, centre (e1 + e2)/2 on the axis."""
+    """Distance 2 edges (jog-measuring §2.5.3): L = |e2 − e1|, centre (e1 + e2)/2 on the axis;
+    with ``line_angle`` along that line instead (``distance_along_line``)."""
     t1, t2 = _edge_points(task, points, 2)
+    if params.get("line_angle") is not None:
+        return distance_along_line(task, params, t1, t2, plane)
     axis = _measuring_axis(params, t1)
     j = axis_index(axis)
     e1, e2 = float(t1.surface[j]), float(t2.surface[j])
@@ -299,6 +302,38 @@ def evaluate_edge_distance(task: str, params: dict[str, Any], points: Sequence[S
     values = {"distance": abs(e2 - e1), "center": {axis: centre}, "axis": axis,
               "points": _touch_values(plane, [t1, t2])}
     return TaskResult(task, values, FeatureFix(position={axis: centre}, point=point))
+
+
+def line_unit(plane: Plane, angle_deg: float) -> FloatArray:
+    """û = (cos θ, sin θ) in the plane's (abscissa, ordinate), as a WCS vector (measuring-math §10.2)."""
+    t = float(np.radians(angle_deg))
+    unit: FloatArray = np.cos(t) * plane.unit(plane.first) + np.sin(t) * plane.unit(plane.second)
+    return unit
+
+
+def distance_along_line(task: str, params: dict[str, Any], t1: Touch, t2: Touch, plane: Plane) -> TaskResult:
+    """Slot or web at an angle (CYCLE979 _MVAR 3/4/103/104; manual §5.6.1, measuring-math §10.2).
+
+    û = (cos θ, sin θ), θ = ``line_angle`` (_STA1); s_i = the touches' surface points
+    (c_i + ρ·d̂_i, measuring-math §5.3); W = |(s1 − s2)·û|, mid = (s1 + s2)/2. Only the centre's
+    component along the line is known (measuring-math §10.2): centre = CP + ((mid − CP)·û)·û,
+    CP = ``setpoint`` (a, o). §10.2 prints slot W = (s1 − s2)·û, web W = (s2 − s1)·û; with its own
+    travels (web P1 from the +û side, as the slot's P1) both touch the +û wall first, so the web's
+    printed sign gives −W: the magnitude is what both mean (as distance 2 edges, jog-measuring §2.5.3).
+    """
+    u = line_unit(plane, float(params["line_angle"]))
+    s1, s2 = np.asarray(t1.surface, float), np.asarray(t2.surface, float)
+    width = abs(float((s1 - s2) @ u))                                           # measuring-math §10.2
+    mid = 0.5 * (s1 + s2)
+    setpoint = params["setpoint"]
+    height = float(plane.to_aop(mid)[2])
+    cp = plane.to_xyz(np.array([float(setpoint[plane.first]), float(setpoint[plane.second]), height]))
+    centre = cp + float((mid - cp) @ u) * u                                     # measuring-math §10.2 d = ((mid − CP)·û)·û
+    centre_ao = {plane.first: float(centre @ plane.unit(plane.first)),
+                 plane.second: float(centre @ plane.unit(plane.second))}
+    values = {"distance": width, "center": centre_ao, "axis": params.get("axis", plane.first),
+              "line_angle": float(params["line_angle"]), "points": _touch_values(plane, [t1, t2])}
+    return TaskResult(task, values, FeatureFix(position=dict(centre_ao), point=centre))
 
 
 # --- corners ----------------------------------------------------------------------------------

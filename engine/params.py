@@ -94,8 +94,23 @@ def validate_edge(variant: str, params: dict[str, Any], plane: Plane) -> dict[st
         if variant == "distance":
             opposite = "-" if out["direction"] == "+" else "+"
             out["direction_p2"] = param_choice(params, "direction_p2", ("+", "-"), opposite)
-        out["setpoint"] = _setpoint_axis(params, out["axis"])
+        if variant == "distance" and params.get("line_angle") is not None:
+            out["line_angle"] = _line_angle(params)
+            out["setpoint"] = _setpoint_point(params, plane)
+        else:
+            out["setpoint"] = _setpoint_axis(params, out["axis"])
     return _passthrough_target(params, out)
+
+
+def _line_angle(params: dict[str, Any]) -> float:
+    """Distance 2 edges measured along a line at an angle (CYCLE979 slot/web, measuring-math §10.2):
+    the line's angle from the plane's 1st axis, −360..360° (``_STA1``, manual §5.6 parameters).
+    Then ``direction``/``direction_p2`` are the travels' signs along the line, ``setpoint`` the
+    point (a, o) the line runs through."""
+    value = param_number(params, "line_angle", 0.0, bound=MAX_MAGNITUDE) or 0.0
+    if not -360.0 <= value <= 360.0:
+        raise ParamError("line_angle", f"line_angle must lie in -360..360, got {value:g}")
+    return value
 
 
 def validate_corner(variant: str, params: dict[str, Any], plane: Plane) -> dict[str, Any]:

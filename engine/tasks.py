@@ -101,7 +101,11 @@ def _along_axis(params: dict[str, Any], n: int, plane: Plane) -> FloatArray:
 
 
 def _distance_direction(params: dict[str, Any], n: int, plane: Plane) -> FloatArray:
-    return sign_of(params["direction" if n == 1 else "direction_p2"]) * plane.unit(params["axis"])
+    """± the axis, or ± the line at ``line_angle`` (measuring-math §10.2, as the evaluation reads it)."""
+    sign = sign_of(params["direction" if n == 1 else "direction_p2"])
+    if params.get("line_angle") is not None:
+        return sign * ev.line_unit(plane, float(params["line_angle"]))
+    return sign * plane.unit(params["axis"])
 
 
 def _corner_direction(params: dict[str, Any], n: int, plane: Plane) -> FloatArray:

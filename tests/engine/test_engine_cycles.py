@@ -11,6 +11,7 @@ import pytest
 from engine.cycles import (
     SpherePoint,
     angle_circle_program,
+    angle_line_program,
     cycle119,
     evaluate_sphere,
     reframed,
@@ -19,7 +20,7 @@ from engine.cycles import (
 from engine.frames import Frame, rot_z
 from engine.plan_base import PlanContext
 from engine.planes import PLANES
-from engine.types import Latch, MoveStep, ProbeRecord, ProbeStep
+from engine.types import EdgePoint, Latch, MoveStep, ProbeRecord, ProbeStep
 
 G17 = PLANES["G17"]
 TRIG = {"X-": 2.990, "X+": -2.990, "Y-": 2.990, "Y+": -2.990, "Z-": 2.990}
@@ -202,3 +203,68 @@ def test_sphere_positioning_never_enters_the_sphere(angle, offset, height):
     except StopIteration as done:
         assert done.value.center == pytest.approx(true_c, abs=1e-9)
     assert moves > 0
+
+
+def wall_contact(cp, u, along, rho):
+    """Ball (radius ``rho``) centre switching on the wall at ``along`` from ``cp`` on the line û:
+    the centre stops ``rho`` before it, on the side it comes from."""
+    def latch(pos, step):
+        d = np.asarray(step.direction, float)
+        travel = float(d @ u)
+        s = (along - rho * math.copysign(1.0, travel) - float((pos - cp) @ u)) / travel
+        assert 0.0 <= s <= step.distance, "the probing move misses the wall"
+        return pos + s * d
+    return latch
+
+
+@pytest.mark.parametrize(("inner", "angle", "width", "along"), [
+    (True, 70.0, 130.01, 0.3),        # the §5.6.3 slot
+    (False, 25.0, 39.98, 0.15),       # a web
+    (True, -200.0, 20.02, -0.4),
+])
+def test_slot_and_web_at_an_angle_against_analytic_walls(inner, angle, width, along):
+    """measuring-math §10.2: touches along ±û on the line through CP; W and the centre's component
+    along û of walls placed here (an ideal ball, ρ = 3, _FA = 2)."""
+    from engine.evaluate import distance_along_line
+    probe = ProbeRecord(ball_diameter=6.0)
+    fa, lift = 2.0, 30.0
+    cp = np.array([150.0, 130.0, 40.0])
+    u = np.array([math.cos(math.radians(angle)), math.sin(math.radians(angle)), 0.0])
+    plan = {"center": (150.0, 130.0), "width": round(width), "start_angle": angle, "inner": inner, "lift": lift}
+    start = cp + (0.0 if inner else round(width) / 2 + 8.0) * u
+    walls = (along + width / 2, along - width / 2)              # the +û and the −û wall
+    touches, probes, starts = [], [], []
+    for n, wall in zip((1, 2), walls, strict=True):
+        point, steps = drive(angle_line_program(plan, n, start, ctx_for(probe, fa), f"P{n}"),
+                             wall_contact(cp, u, wall, 3.0))
+        assert isinstance(point, EdgePoint)
+        touches.append(point.touch)
+        probes.extend(steps)
+        starts.append(steps[0][0])
+        start = starts[-1]                                       # each point ends at its P'
+    signs = (1.0, -1.0) if inner else (-1.0, 1.0)               # slot P1 +û, P2 −û; web P1 −û, P2 +û
+    for (_pos, step), sign in zip(probes, signs, strict=True):
+        assert step.direction == pytest.approx(sign * u)
+    reach = round(width) / 2 + (-3.0 - fa if inner else 3.0 + fa)
+    assert starts[0] == pytest.approx(cp + reach * u) and starts[1] == pytest.approx(cp - reach * u)
+    params = {"line_angle": angle, "setpoint": {"X": 150.0, "Y": 130.0}, "axis": "X"}
+    result = distance_along_line("edge.distance", params, touches[0], touches[1], G17)
+    assert result.values["distance"] == pytest.approx(width, abs=1e-9)
+    centre = cp + along * u
+    assert [result.values["center"][a] for a in "XY"] == pytest.approx(list(centre[:2]), abs=1e-9)
+    assert result.fix.position == pytest.approx(result.values["center"])
+
+
+def test_web_at_an_angle_crosses_over_at_the_lift():
+    """The web's P2 (measuring-math §10.2, manual §5.6.1): up by _ID, over to P2', down."""
+    probe = ProbeRecord(ball_diameter=6.0)
+    plan = {"center": (0.0, 0.0), "width": 40.0, "start_angle": 90.0, "inner": False, "lift": 50.0}
+    program = angle_line_program(plan, 2, np.array([0.0, 25.0, 10.0]), ctx_for(probe, 2.0), "P2")
+    moves = []
+    step = program.send(None)
+    while isinstance(step, MoveStep):
+        moves.append(np.asarray(step.target, float))
+        step = program.send(None)
+    assert moves == [pytest.approx([0.0, 25.0, 60.0]), pytest.approx([0.0, -25.0, 60.0]),
+                     pytest.approx([0.0, -25.0, 10.0])]
+    assert isinstance(step, ProbeStep) and step.direction == pytest.approx([0.0, 1.0, 0.0])
