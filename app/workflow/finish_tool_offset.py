@@ -15,6 +15,8 @@ from app.gud import GudSettings
 from app.workflow.context import MeasuringContext, ToolOffsetChange, ToolOffsetOutcome
 from app.workflow.session import MeasureSession
 from engine import alarms
+from engine.evaluate import line_unit
+from engine.planes import Plane
 from engine.strategy import Decision, Tolerance, decide_tool_offset, repeat_measurement
 from engine.tasks import evaluate
 from engine.tool_offset import tool_offset_update
@@ -58,7 +60,8 @@ def target_label(target: dict) -> str:
 
 # --- what each task measures (measuring-math §8.3, measuring-math §9.1) ---------------------------------------
 
-def _feature(task: str, params: dict, values: dict, points: list) -> tuple[str, float, float | None, int | None]:
+def _feature(task: str, params: dict, values: dict, points: list, plane: Plane
+             ) -> tuple[str, float, float | None, int | None]:
     """(feature kind, actual value, default setpoint, probing direction ±1 or None)."""
     if task in ("hole.1", "spigot.1"):
         return ("bore" if task == "hole.1" else "shaft"), float(values["diameter"]), params.get("diameter"), None
@@ -68,7 +71,9 @@ def _feature(task: str, params: dict, values: dict, points: list) -> tuple[str, 
         mean_difference = ((values["length"] - params["length"]) + (values["width"] - params["width"])) / 2.0
         return ("inner_rectangle" if task == "pocket.rect" else "outer_rectangle"), mean_difference, 0.0, None
     if task == "edge.distance":
-        e1, e2 = (float(p.touch.surface @ _axis_unit(params["axis"])) for p in points if isinstance(p, EdgePoint))
+        unit = _axis_unit(params["axis"]) if params.get("line_angle") is None else \
+            line_unit(plane, float(params["line_angle"]))          # CYCLE979 slot/web (measuring-math §10.2)
+        e1, e2 = (float(p.touch.surface @ unit) for p in points if isinstance(p, EdgePoint))
         d1 = 1 if params["direction"] == "+" else -1
         inner = d1 * (e1 - e2) > 0.0          # the wall reached travelling + lies on the + side: a slot
         return ("slot" if inner else "web"), abs(e2 - e1), None, None
@@ -92,7 +97,7 @@ def finish_tool_offset(session: MeasureSession, ctx: MeasuringContext, points: l
     target = session.target
     assert isinstance(target, dict), "a WO target is finished by finish.finish_workpiece"
     try:
-        feature, actual, default_setpoint, direction = _feature(session.task, session.params, result.values, points)
+        feature, actual, default_setpoint, direction = _feature(session.task, session.params, result.values, points, ctx.plane)
         tolerance = Tolerance.from_params(session.params.get("tolerance"),
                                           tolerance_defaults(ctx.settings, default_setpoint or 0.0))
     except ValueError as exc:

@@ -5,7 +5,7 @@
 |---|---|---|
 | CYCLE977 | 1/101 bore, 2/102 shaft, 3/103 slot, 4/104 web, 5/105 inner, 6/106 outer rectangle | hole.1, spigot.1, edge.distance (+, −), pocket.rect, spigot.rect |
 | CYCLE978 | 0 surface + tool offset, 100 surface + ZO | edge.set |
-| CYCLE979 | 1/101 bore, 2/102 shaft at an angle (3 or 4 points; ``_NPTS`` 3..36) | hole.1 / spigot.1 with the CYCLE979 plan (engine.cycles) |
+| CYCLE979 | 1/101 bore, 2/102 shaft at an angle (3 or 4 points; ``_NPTS`` 3..36), 3/103 slot, 4/104 web at ``_STA1`` | hole.1 / spigot.1 / edge.distance (along the line, ``line_angle``) with the CYCLE979 plans (engine.cycles) |
 | CYCLE998 | 105, 100105 one angle | edge.align |
 | CYCLE961 | 105/106 rectangle corner, 107/108 any corner, 117/118 from 4 given points | corner.right / corner.any with the cycle's points and directions |
 
@@ -33,7 +33,7 @@ from app.nc.cycles.base import (
 from app.workflow.tasks import TASKS
 from engine import alarms
 from engine.compensation import effective_radius, trigger_radius
-from engine.cycles import angle_circle_program
+from engine.cycles import angle_circle_program, angle_line_program
 from engine.params import MAX_CIRCLE_POINTS, MIN_CIRCLE_POINTS
 from engine.plan_workpiece import edge_program
 from engine.tasks import evaluate
@@ -319,21 +319,55 @@ def _points_979(call: Call) -> int:
     return circle_points(call) or (4 if digit_at(call.integer("_PRNUM"), 4) == 1 else 3)
 
 
-def cycle979(call: Call) -> None:
-    v = call.variant
-    if v in (3, 4, 103, 104):
-        raise variant_error(call, "slot and web at an angle (3/4, 103/104) are not supported")
-    if v not in (1, 2, 101, 102):
-        raise variant_error(call, "CYCLE979 measures 1 bore or 2 shaft (+100 ZO)")
+def _setval979(call: Call) -> float:
+    setval = call.length("_SETVAL")
+    if not setval > 0.0:
+        raise CycleAlarm(alarms.NC_VALUE_RANGE, f"_SETVAL = {setval:g}: the diameter/width must be > 0")
+    return setval
+
+
+def _sta1_979(call: Call) -> float:
+    """_STA1, the start angle: −360..360° (manual §5.6 parameters)."""
+    sta1 = call.real("_STA1")
+    if not -360.0 <= sta1 <= 360.0:
+        raise CycleAlarm(alarms.NC_VALUE_RANGE, f"_STA1 = {sta1:g}: the start angle lies within −360..360°")
+    return sta1
+
+
+def _results979(call: Call, answer: dict, size_key: str, cp: tuple[float, float], setval: float,
+                tool: bool) -> None:
+    """_OVR of CYCLE979 (manual §5.6 results, as CYCLE977 measuring-math §8.4): [0] setpoint,
+    [1, 2] setpoint centre, [4] actual, [5, 6] actual centre, [16..18] differences, tolerances."""
+    a, o = call.plane.first, call.plane.second
+    cpa, cpo = cp
+    result = answer.get("result") or {}
+    centre = result.get("center") or {}
+    size = float(result[size_key])
+    ca, co = centre.get(a, cpa), centre.get(o, cpo)
+    _tolerance_results(call, answer, setval, tool)
+    for slot, value in ((1, cpa), (2, cpo), (4, size), (5, ca), (6, co), (16, size - setval), (17, ca - cpa),
+                        (18, co - cpo)):
+        call.ovr[slot] = call.out(value)
+    call.common_results(answer)
+
+
+def _centre_differences979(cpa: float, cpo: float, a: str, o: str):
+    """The ZO variants' differences for _TSA: the centre's on both plane axes (manual §5.6.3)."""
+    def differences(result):
+        centre = result.get("center") or {}
+        return [centre.get(a, cpa) - cpa, centre.get(o, cpo) - cpo]
+    return differences
+
+
+def _circle979(call: Call, v: int) -> None:
+    """Bore (1/101) or shaft (2/102) at an angle (measuring-math §10.1)."""
     bore = v % 100 == 1
     env = call.measuring()
     setup = env.setup()
     plane = call.plane
     a, o = plane.first, plane.second
     cpa, cpo = call.length("_CPA"), call.length("_CPO")
-    setval = call.length("_SETVAL")
-    if not setval > 0.0:
-        raise CycleAlarm(alarms.NC_VALUE_RANGE, f"_SETVAL = {setval:g}: the diameter must be > 0")
+    setval = _setval979(call)
     points = _points_979(call)
     rf = call.real("_RF")
     plan = {"center": (cpa, cpo), "diameter": setval, "start_angle": call.real("_STA1"),
@@ -349,19 +383,50 @@ def cycle979(call: Call) -> None:
     if tool:
         params["tolerance"] = call.tolerance(setval)
     elif v > 100:
-        def differences(result):
-            centre = result.get("center") or {}
-            return [centre.get(a, cpa) - cpa, centre.get(o, cpo) - cpo]
-        spec = with_finisher(spec, _check_safe_area(call, differences))
+        spec = with_finisher(spec, _check_safe_area(call, _centre_differences979(cpa, cpo, a, o)))
     answer = call.run(env, spec, params, target)
-    result = answer.get("result") or {}
-    centre = result.get("center") or {}
-    size = float(result["diameter"])
-    _tolerance_results(call, answer, setval, tool)
-    for slot, value in ((1, cpa), (2, cpo), (4, size), (5, centre.get(a, cpa)), (6, centre.get(o, cpo)),
-                        (16, size - setval), (17, centre.get(a, cpa) - cpa), (18, centre.get(o, cpo) - cpo)):
-        call.ovr[slot] = call.out(value)
-    call.common_results(answer)
+    _results979(call, answer, "diameter", (cpa, cpo), setval, tool)
+
+
+def _line979(call: Call, v: int) -> None:
+    """Slot (3/103) or web (4/104) at an angle (manual §5.6.1, measuring-math §10.2): the JOG
+    task distance 2 edges along the line through (_CPA, _CPO) at _STA1, with the CYCLE979 plan."""
+    slot = v % 100 == 3
+    sta1 = _sta1_979(call)
+    setval = _setval979(call)
+    lift = call.length("_ID")
+    if not slot and not lift > 0.0:
+        raise CycleAlarm(alarms.NC_VALUE_RANGE, f"_ID = {call.real('_ID'):g}: the web is crossed over at the "
+                         "measuring height + _ID: _ID > 0")
+    env = call.measuring()
+    setup = env.setup()
+    plane = call.plane
+    a, o = plane.first, plane.second
+    cpa, cpo = call.length("_CPA"), call.length("_CPO")
+    target = call.zo_target(setup) if v > 100 else call.tool_target()
+    tool = isinstance(target, dict)
+    plan = {"center": (cpa, cpo), "width": setval, "start_angle": sta1, "inner": slot, "lift": lift}
+    spec = with_planner(TASKS["edge.distance"],
+                        lambda params, n, start, ctx, label: angle_line_program(plan, n, start, ctx, label))
+    # directions: the travels' signs along û (slot P1 +û, web P1 −û), read by the evaluation
+    params = {"axis": a, "direction": "+" if slot else "-", "direction_p2": "-" if slot else "+",
+              "line_angle": sta1, "setpoint": {a: cpa, o: cpo}, "measurements": call.measurements()}
+    if tool:
+        params["tolerance"] = call.tolerance(setval)
+    elif v > 100:
+        spec = with_finisher(spec, _check_safe_area(call, _centre_differences979(cpa, cpo, a, o)))
+    answer = call.run(env, spec, params, target)
+    _results979(call, answer, "distance", (cpa, cpo), setval, tool)
+
+
+def cycle979(call: Call) -> None:
+    v = call.variant
+    if v not in (1, 2, 3, 4, 101, 102, 103, 104):
+        raise variant_error(call, "CYCLE979 measures 1 bore, 2 shaft, 3 slot or 4 web at an angle (+100 ZO)")
+    if v % 100 in (1, 2):
+        _circle979(call, v)
+    else:
+        _line979(call, v)
 
 
 # --- CYCLE998 (measuring-math §11.1) -------------------------------------------------------------------
