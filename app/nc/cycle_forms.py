@@ -82,7 +82,7 @@ CYCLES: dict[str, tuple[CycleField, ...]] = {
     "CYCLE978": (_VARIANT, _SETVAL, _AXIS, _KNUM, *_COMMON, *_TOOL_OFFSET),
     "CYCLE979": (_VARIANT, _SETVAL, _real("_CPA", N_("Centre point, abscissa")),
                  _real("_CPO", N_("Centre point, ordinate")), _real("_STA1", N_("Starting angle")),
-                 _real("_INCA", N_("Indexing angle")), _KNUM, _NPTS, *_COMMON, *_TOOL_OFFSET),
+                 _real("_INCA", N_("Indexing angle")), _INFEED, _KNUM, _NPTS, *_COMMON, *_TOOL_OFFSET),
     "CYCLE998": (_VARIANT, _SETVAL, _real("_SETV[0]", N_("Setpoint of the second angle")), _AXIS, _INFEED,
                  _real("_STA1", N_("Starting angle")), _real("_RA", N_("Rotary axis correction")), _KNUM, *_COMMON),
     "CYCLE961": (_VARIANT, _real("_SETV[0]", N_("Setpoint length")), _real("_SETV[1]", N_("Setpoint width")),
