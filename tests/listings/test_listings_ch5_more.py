@@ -301,3 +301,30 @@ def test_slot_listing_checks_the_safe_area_on_each_axis(client, along, corrected
         assert answer["state"] == "alarm" and answer["alarm"]["code"] == 61303, answer
         assert answer["block"]["number"] == 70, answer["block"]
         assert _total(m.offset("G55")) == g55
+
+
+def test_web_at_25_degrees_corrects_the_radius_of_t20(client):
+    """CYCLE979 _MVAR=4 (web, tool offset) along û = (cos 25°, sin 25°) through _CPA=120 _CPO=90,
+    _SETVAL=40, _ID=50, _KNUM=2001, _TNUM=20, the §5.6.2 listing's tolerances. Part: a web 40.024
+    wide along û from Z20 up to Z90, its middle 0.05 along û from (120, 90). D = 0.024 > _TMV,
+    inside _TUL → 100 %: web c = −D/2 on T20 D1's radius wear (measuring-math §2.3, §3.5)."""
+    along, width, angle = 0.05, 40.024, 25.0
+    u = np.array([math.cos(math.radians(angle)), math.sin(math.radians(angle))])
+    cp = np.array([120.0, 90.0])
+    m = Machine(client)
+    _load(m, _turned_block(tuple(cp + along * u), angle, (200.0, 160.0), 20.0,
+                           {"type": "boss", "size": [width, 120.0], "height": 70.0}), rot_z=angle, tools=(T20,))
+    g54, before = _total(m.offset("G54")), m.tool(20)
+    answer = m.mda(f"G54 G17 G90 T9 D1\nM6\nG0 Z120\n{_at(cp + 30.0 * u)}\nZ50\n_CHBIT[4]=1\n"
+                   "_TUL=0.03 _TLL=-0.03 _EVNUM=20 _K=3 _TZL=0.01 _TMV=0.02 _TDIF=0.06 _TSA=1 _PRNUM=1 "
+                   "_VMS=0 _NMSP=1 _FA=2\n"
+                   "_MVAR=4 _SETVAL=40 _STA1=25 _ID=50 _TNUM=20 _KNUM=2001 _CPA=120 _CPO=90\n"
+                   "CYCLE979\nG0 Z160\nM2")
+    assert answer["state"] == "done", answer
+    ovr = m.ovr()
+    assert ovr[4] == pytest.approx(width, abs=1e-6)
+    assert ovr[5:7] == pytest.approx(list(cp + along * u), abs=1e-6)
+    assert ovr[20] == pytest.approx(-(width - 40.0) / 2, abs=1e-6)
+    after = m.tool(20)
+    assert after["wear"]["radius"] - before["wear"]["radius"] == pytest.approx(-(width - 40.0) / 2, abs=1e-6)
+    assert _total(m.offset("G54")) == g54
