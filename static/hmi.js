@@ -182,11 +182,15 @@
     });
     if (Object.keys(changed).length) event.detail.xhr.hmiChanged = { form: sent.form, values: changed };
   });
-  document.addEventListener("htmx:afterSettle", function (event) {
-    var changed = event.detail.xhr && event.detail.xhr.hmiChanged;
+  // put back as soon as the answer is in (htmx:afterSwap), not after htmx's settle delay: an NC
+  // Start pressed in between sent the answer's values, not the typed ones (seen once under load);
+  // a resent form is sent again once settled, when htmx has taken in the new controls
+  function putBack(event) {
+    var xhr = event.detail.xhr;
+    var changed = xhr && xhr.hmiChanged;
     var form = changed && document.getElementById(changed.form);
     if (!form) return;
-    delete event.detail.xhr.hmiChanged;
+    delete xhr.hmiChanged;
     var first = null;
     Object.keys(changed.values).forEach(function (name) {
       var value = changed.values[name];
@@ -203,7 +207,15 @@
         first = first || control;
       });
     });
-    if (first && RESENT_FORMS[changed.form]) htmx.trigger(first, "change");
+    if (first && RESENT_FORMS[changed.form]) xhr.hmiResend = first;
+  }
+  document.addEventListener("htmx:afterSwap", putBack);
+  document.addEventListener("htmx:afterSettle", function (event) {
+    putBack(event);
+    var xhr = event.detail.xhr, first = xhr && xhr.hmiResend;
+    if (!first) return;
+    delete xhr.hmiResend;
+    if (document.body.contains(first)) htmx.trigger(first, "change");
   });
 
   function post(url, data) {

@@ -200,9 +200,14 @@ def test_what_is_typed_while_a_new_target_loads_is_kept(tab, station):
         assert len(held) == 1
         fill(tab, axis="Y", setpoint="12.5")                         # typed while it is on its way
         tab.evaluate("document.getElementById('task-form').dataset.stale = '1'")
+        # what the form holds the moment the answer is in: an NC Start then must send the typed values
+        tab.evaluate("document.addEventListener('htmx:afterSwap', () => { const f ="
+                     " document.querySelector('#task-form:not([data-stale]) [name=\"setpoint\"]');"
+                     " if (f && window.atSwap === undefined) window.atSwap = f.value; })")
         held.pop().continue_()
         expect(tab.locator("#task-form[data-stale]")).to_have_count(0)     # the new screen is in
-        tab.wait_for_timeout(100)                                          # and settled
+        expect(tab.locator(".htmx-settling")).to_have_count(0)             # and settled
+        assert tab.evaluate("window.atSwap") == "12.5"
         expect(tab.locator('#task-form select[name="target"]')).to_have_value("G54")
         expect(tab.locator('#task-form [name="axis"]')).to_have_value("Y")
         expect(tab.locator('#task-form [name="setpoint"]')).to_have_value("12.5")

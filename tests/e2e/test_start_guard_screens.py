@@ -29,11 +29,13 @@ def hole1_screen_with_diameter(page, diameter: float):
     expect(page.locator("#task-form")).to_be_visible()
     target = page.locator('#task-form select[name="target"]')
     if target.count():
-        target.select_option("measure_only")
+        with page.expect_response("**/refresh"):        # the choice re-draws the screen
+            target.select_option("measure_only")
     field = page.locator('#task-form [name="diameter"]')
     field.fill(f"{diameter:g}")
     field.press("Tab")
-    expect(field).to_have_value(f"{diameter:g}")     # kept after the field's check has answered
+    expect(page.locator(".htmx-request, .htmx-settling")).to_have_count(0)
+    expect(field).to_have_value(f"{diameter:g}")
     return field
 
 
