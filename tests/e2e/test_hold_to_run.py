@@ -82,11 +82,15 @@ def test_each_tab_jogs_its_own_axis(browser, live_server, api):
         expect(tab_a.locator("#mcp")).to_have_attribute("data-axis", "X")
         expect(tab_a.locator("#mcp")).to_have_attribute("data-increment", "1000")   # lit before jogging
         start = api.get("/api/machine").json()["mcs"]
-        tab_a.locator('#mcp button[data-jog="+"]').click()
-        expect(tab_a.locator('#position-values td.value[data-axis="X"]')).not_to_have_text(
-            f"{start['X'] - 100.0:.3f}")
+        # the step's answer comes when the move has ended (POST /ui/jog blocks like the API)
+        with tab_a.expect_response(lambda r: r.url.endswith("/ui/jog") and r.request.method == "POST") as jogged:
+            tab_a.locator('#mcp button[data-jog="+"]').click()
+        assert jogged.value.ok
+        expect(tab_a.locator("#message")).not_to_have_class(re.compile(r"\berror\b"))
         mcs = settle(api)["mcs"]
-        assert mcs["X"] == pytest.approx(start["X"] + 1.0) and mcs["Y"] == pytest.approx(start["Y"])
+        assert mcs["X"] == pytest.approx(start["X"] + 1.0) and mcs["Y"] == pytest.approx(start["Y"]), \
+            (f"jog request headers {jogged.value.request.headers}, "
+             f"message {tab_a.locator('#message').inner_text()!r}")
         tab_a.reload()                                   # the tab keeps its selection
         expect(tab_a.locator("#mcp")).to_have_attribute("data-axis", "X")
         expect(tab_b.locator("#mcp")).to_have_attribute("data-axis", "Y")
