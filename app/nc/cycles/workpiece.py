@@ -359,6 +359,20 @@ def _centre_differences979(cpa: float, cpo: float, a: str, o: str):
     return differences
 
 
+def _run979(call: Call, env, spec, params: dict, target, size_key: str, cp: tuple[float, float],
+            setval: float) -> None:
+    """Run a CYCLE979 variant: a tool offset with its tolerance, a ZO with the safe area on the
+    centre's differences (manual §5.6.3); then its results."""
+    tool = isinstance(target, dict)
+    if tool:
+        params["tolerance"] = call.tolerance(setval)
+    elif call.variant > 100:
+        spec = with_finisher(spec, _check_safe_area(call, _centre_differences979(*cp, call.plane.first,
+                                                                               call.plane.second)))
+    answer = call.run(env, spec, params, target)
+    _results979(call, answer, size_key, cp, setval, tool)
+
+
 def _circle979(call: Call, v: int) -> None:
     """Bore (1/101) or shaft (2/102) at an angle (measuring-math §10.1)."""
     bore = v % 100 == 1
@@ -374,18 +388,12 @@ def _circle979(call: Call, v: int) -> None:
             "increment": call.real("_INCA"), "points": points, "inner": bore,
             "circle_feed": call.ctx.modal.feed_to_mm(rf) if rf > 0.0 else None}
     target = call.zo_target(setup) if v > 100 else call.tool_target()
-    tool = isinstance(target, dict)
     spec = with_planner(TASKS["hole.1" if bore else "spigot.1"],
                         lambda params, n, start, ctx, label: angle_circle_program(plan, start, ctx, label))
     params = {"diameter": setval, "setpoint": {a: cpa, o: cpo}, "measurements": call.measurements()}
     if not bore:
         params["infeed"] = 1.0          # the JOG spigot's DZ; CYCLE979 probes at the start height
-    if tool:
-        params["tolerance"] = call.tolerance(setval)
-    elif v > 100:
-        spec = with_finisher(spec, _check_safe_area(call, _centre_differences979(cpa, cpo, a, o)))
-    answer = call.run(env, spec, params, target)
-    _results979(call, answer, "diameter", (cpa, cpo), setval, tool)
+    _run979(call, env, spec, params, target, "diameter", (cpa, cpo), setval)
 
 
 def _line979(call: Call, v: int) -> None:
@@ -404,19 +412,13 @@ def _line979(call: Call, v: int) -> None:
     a, o = plane.first, plane.second
     cpa, cpo = call.length("_CPA"), call.length("_CPO")
     target = call.zo_target(setup) if v > 100 else call.tool_target()
-    tool = isinstance(target, dict)
     plan = {"center": (cpa, cpo), "width": setval, "start_angle": sta1, "inner": slot, "lift": lift}
     spec = with_planner(TASKS["edge.distance"],
                         lambda params, n, start, ctx, label: angle_line_program(plan, n, start, ctx, label))
     # directions: the travels' signs along û (slot P1 +û, web P1 −û), read by the evaluation
     params = {"axis": a, "direction": "+" if slot else "-", "direction_p2": "-" if slot else "+",
               "line_angle": sta1, "setpoint": {a: cpa, o: cpo}, "measurements": call.measurements()}
-    if tool:
-        params["tolerance"] = call.tolerance(setval)
-    elif v > 100:
-        spec = with_finisher(spec, _check_safe_area(call, _centre_differences979(cpa, cpo, a, o)))
-    answer = call.run(env, spec, params, target)
-    _results979(call, answer, "distance", (cpa, cpo), setval, tool)
+    _run979(call, env, spec, params, target, "distance", (cpa, cpo), setval)
 
 
 def cycle979(call: Call) -> None:
