@@ -130,12 +130,19 @@ def test_hole_segment_listing_corrects_the_radius_of_t20(client):
     assert m.wcs()["Z"] == pytest.approx(160.0)
 
 
+def _line(angle: float, cp, along: float = 0.0, across: float = 0.0):
+    """û = (cos angle, sin angle), n̂ its normal (û turned +90°), and the point ``along`` û and
+    ``across`` n̂ from ``cp`` (the feature's true middle): the truth of measuring-math §10.2."""
+    u = np.array([math.cos(math.radians(angle)), math.sin(math.radians(angle))])
+    n = np.array([-u[1], u[0]])
+    return u, n, np.asarray(cp, float) + along * u + across * n
+
+
 def _turned_block(centre: tuple[float, float], angle: float, size: tuple[float, float], top: float,
                   feature: dict) -> dict:
     """A block ``size`` (part x along û = (cos angle, sin angle)) turned by ``angle`` about Z with
     its centre at G54/G55 ``centre`` and ``feature`` in its middle; the part's top at Z ``top``."""
-    u = (math.cos(math.radians(angle)), math.sin(math.radians(angle)))
-    n = (-u[1], u[0])
+    u, n, _ = _line(angle, (0.0, 0.0))
     cx, cy = size[0] / 2, size[1] / 2
     origin = (centre[0] - (u[0] * cx + n[0] * cy), centre[1] - (u[1] * cx + n[1] * cy), top)
     return {"origin": origin, "size": (*size, 100), "features": [{**feature, "center": [cx, cy]}]}
@@ -151,10 +158,8 @@ def test_slot_at_70_degrees_listing_shifts_g55_along_the_line_by_the_slots_true_
     §5.6.3); G54 is unchanged. The cycle ends with the ball _FA before P2's nominal wall
     (P2' = CP − (65 − ρ − _FA)·û, ρ = 2), N80 lifts to Z160, N90 reads it in the new G55."""
     along, across, width, angle = 0.3, 0.2, 130.01, 70.0
-    u = np.array([math.cos(math.radians(angle)), math.sin(math.radians(angle))])
-    n = np.array([-u[1], u[0]])
     cp = np.array([150.0, 130.0])
-    mid = cp + along * u + across * n
+    u, n, mid = _line(angle, cp, along, across)
     m = Machine(client)
     _load(m, _turned_block(tuple(mid), angle, (200.0, 160.0), 60.0,
                            {"type": "pocket", "size": [width, 80.0], "depth": 40.0}), rot_z=angle)
@@ -191,10 +196,8 @@ def test_web_at_25_degrees_shifts_g54_along_the_line_by_the_webs_true_middle(cli
     P2 travels +û. measuring-math §10.2: W = (s2 − s1)·û, G54 += ((mid − CP)·û)·û = 0.15·û; the
     cycle ends at P2' = CP − (20 + ρ + _FA)·û, ρ = 2, at the measuring height."""
     along, across, width, angle = 0.15, 0.4, 39.98, 25.0
-    u = np.array([math.cos(math.radians(angle)), math.sin(math.radians(angle))])
-    n = np.array([-u[1], u[0]])
     cp = np.array([120.0, 90.0])
-    mid = cp + along * u + across * n
+    u, n, mid = _line(angle, cp, along, across)
     m = Machine(client)
     _load(m, _turned_block(tuple(mid), angle, (200.0, 160.0), 20.0,
                            {"type": "boss", "size": [width, 120.0], "height": 70.0}), rot_z=angle)
@@ -228,10 +231,8 @@ def test_slot_at_minus_35_degrees_corrects_the_radius_of_t20(client):
     and 0.3 across it from (120, 60); measuring height Z20. D = 0.024 > _TMV, inside _TUL →
     100 %: slot c = +D/2 on T20 D1's radius wear (measuring-math §2.3, §3.5); no ZO changes."""
     along, across, width, angle = 0.1, 0.3, 30.024, -35.0
-    u = np.array([math.cos(math.radians(angle)), math.sin(math.radians(angle))])
-    n = np.array([-u[1], u[0]])
     cp = np.array([120.0, 60.0])
-    mid = cp + along * u + across * n
+    u, n, mid = _line(angle, cp, along, across)
     m = Machine(client)
     _load(m, _turned_block(tuple(mid), angle, (200.0, 160.0), 40.0,
                            {"type": "pocket", "size": [width, 100.0], "depth": 40.0}), rot_z=angle, tools=(T20,))
@@ -286,8 +287,7 @@ def test_slot_listing_checks_the_safe_area_on_each_axis(client, along, corrected
     (150, 130): the manual's explanation (line 13001 ff.) corrects G55 when the centre's
     differences on both axes are below _TSA, else alarm "safe area exceeded" (61303) and G55 stays."""
     angle, width = 70.0, 130.01
-    u = np.array([math.cos(math.radians(angle)), math.sin(math.radians(angle))])
-    mid = np.array([150.0, 130.0]) + along * u
+    u, _n, mid = _line(angle, (150.0, 130.0), along)
     m = Machine(client)
     _load(m, _turned_block(tuple(mid), angle, (200.0, 160.0), 60.0,
                            {"type": "pocket", "size": [width, 80.0], "depth": 40.0}), rot_z=angle)
@@ -309,8 +309,8 @@ def test_web_at_25_degrees_corrects_the_radius_of_t20(client):
     wide along û from Z20 up to Z90, its middle 0.05 along û from (120, 90). D = 0.024 > _TMV,
     inside _TUL → 100 %: web c = −D/2 on T20 D1's radius wear (measuring-math §2.3, §3.5)."""
     along, width, angle = 0.05, 40.024, 25.0
-    u = np.array([math.cos(math.radians(angle)), math.sin(math.radians(angle))])
     cp = np.array([120.0, 90.0])
+    u, _n, _mid = _line(angle, cp)
     m = Machine(client)
     _load(m, _turned_block(tuple(cp + along * u), angle, (200.0, 160.0), 20.0,
                            {"type": "boss", "size": [width, 120.0], "height": 70.0}), rot_z=angle, tools=(T20,))
